@@ -1,0 +1,120 @@
+//! Reading meshes from files: OBJ (through `tobj`) and PLY (own reader).
+//!
+//! Every loader returns a [`RawMesh`] whose positions are finite and whose
+//! indices are in range, or an error naming the file and the place; [`load`]
+//! then cleans it (see [`crate::mesh::clean`]).
+
+mod obj;
+mod ply;
+
+pub use obj::parse_obj;
+pub use ply::parse_ply;
+
+use super::{clean, CleanOptions, CleanReport, Mesh, RawMesh};
+use crate::error::{Error, Result};
+use std::path::Path;
+
+/// Largest input file read, in bytes (4 GiB). Larger files are refused
+/// before anything is allocated.
+pub const MAX_FILE_BYTES: u64 = 4 << 30;
+
+/// A mesh format this crate reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Wavefront OBJ (geometry only; materials are ignored).
+    Obj,
+    /// Stanford PLY, ascii or binary.
+    Ply,
+}
+
+impl Format {
+    /// Picks the format from the file extension, then from the content
+    /// (`ply` magic line; `v `/`f `/`o `/`#` lines for OBJ).
+    ///
+    /// # Errors
+    /// [`Error::UnknownFormat`] when neither tells.
+    pub fn detect(path: &Path, bytes: &[u8]) -> Result<Format> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("obj") => return Ok(Format::Obj),
+            Some("ply") => return Ok(Format::Ply),
+            _ => {}
+        }
+        if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+            return Ok(Format::Ply);
+        }
+        let head = &bytes[..bytes.len().min(4096)];
+        if let Ok(text) = std::str::from_utf8(head) {
+            let obj_like = text.lines().any(|l| {
+                let l = l.trim_start();
+                l.starts_with("v ") || l.starts_with("f ") || l.starts_with("o ")
+            });
+            if obj_like {
+                return Ok(Format::Obj);
+            }
+        }
+        Err(Error::UnknownFormat {
+            file: path.to_owned(),
+            message: "expected a .obj or .ply file (no extension matched and the content \
+                      starts with neither a `ply` line nor OBJ statements)"
+                .into(),
+        })
+    }
+}
+
+/// How [`load`] reads and cleans a file.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Cleaning options (weld of identical positions).
+    pub clean: CleanOptions,
+}
+
+/// Reads a whole file into memory, refusing files over [`MAX_FILE_BYTES`].
+///
+/// # Errors
+/// [`Error::Io`] when the file cannot be read, [`Error::Parse`] when too large.
+pub fn read_file(path: &Path) -> Result<Vec<u8>> {
+    let io = |source| Error::Io {
+        file: path.to_owned(),
+        source,
+    };
+    let len = std::fs::metadata(path).map_err(io)?.len();
+    if len > MAX_FILE_BYTES {
+        return Err(Error::Parse {
+            file: path.to_owned(),
+            place: crate::Place::default(),
+            message: format!(
+                "file is {len} bytes, more than the {MAX_FILE_BYTES} this reader accepts"
+            ),
+        });
+    }
+    std::fs::read(path).map_err(io)
+}
+
+/// Parses mesh bytes in the given format; `path` names the input in errors.
+///
+/// # Errors
+/// As [`parse_obj`] and [`parse_ply`].
+pub fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<RawMesh> {
+    match format {
+        Format::Obj => parse_obj(bytes, path),
+        Format::Ply => parse_ply(bytes, path),
+    }
+}
+
+/// Loads and cleans a mesh file (OBJ or PLY, detected by [`Format::detect`]).
+///
+/// # Errors
+/// [`Error::Io`], [`Error::UnknownFormat`], [`Error::Parse`] with the place
+/// of the problem, or [`Error::InvalidMesh`] when no triangle is left.
+///
+/// Cost: O(file size) time, the file is held in memory while parsing.
+pub fn load(path: &Path, options: LoadOptions) -> Result<(Mesh, CleanReport)> {
+    let bytes = read_file(path)?;
+    let format = Format::detect(path, &bytes)?;
+    let raw = parse(&bytes, format, path)?;
+    clean(raw, options.clean, &path.display().to_string())
+}
