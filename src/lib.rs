@@ -2,6 +2,10 @@
 
 pub mod error;
 pub mod mesh;
+pub mod peers;
 
 pub use error::{Error, Place, Result};
 pub use mesh::Mesh;
+pub mod strip;
+
+pub use strip::{stripify, Strips, StripifyOptions};

@@ -1,0 +1,3 @@
+//! Other people's implementations that `mts` is measured against.
+
+pub mod meshopt;

@@ -1,0 +1,230 @@
+//! The global pass of the hybrid search: rectangular patches of
+//! quadrilaterals, stripped along their rows.
+//!
+//! STRIPE looks for large rectangular regions of quadrilateral faces, whose
+//! rows make long swap-free strips. A triangle mesh has no quadrilaterals,
+//! so they are made first: two triangles are paired across an edge when that
+//! edge is the longest of both (the diagonal of a well-shaped quad, which is
+//! what a triangulated quad grid looks like). Then, from each free quad in
+//! turn and along both of its axes, the pass walks the quad's row through
+//! opposite edges, stacks neighbouring rows on both sides while each quad of
+//! the row has a free quad across its side edge and those quads form a row
+//! of their own, and keeps the larger rectangle if it holds at least
+//! `min_patch_quads` quads. Each row becomes one strip; after all patches
+//! are found, each row strip grows at both ends by the local pass's rule.
+
+use super::greedy::Walk;
+use super::path::slot_to;
+use crate::mesh::NO_NEIGHBOUR;
+use glam::Vec3;
+
+const NO_QUAD: u32 = u32::MAX;
+
+/// A quadrilateral: two triangles and its four outer edges in
+/// counter-clockwise order, each as (triangle, edge slot). Outer edge `i` is
+/// opposite edge `(i + 2) % 4`; each opposite pair has one edge in each
+/// triangle, so a row crossing the quad draws both.
+#[derive(Clone, Copy)]
+struct Quad {
+    edges: [(u32, usize); 4],
+}
+
+/// A quad entered through outer edge `entry` (leaving through `entry + 2`).
+type Step = (u32, usize);
+
+struct Quads<'w, 'a> {
+    walk: &'w mut Walk<'a>,
+    quads: Vec<Quad>,
+    quad_of: Vec<u32>,
+    /// `stamp[q] == current` marks quads already in the patch being built.
+    stamp: Vec<u32>,
+    current: u32,
+}
+
+impl Quads<'_, '_> {
+    fn is_free(&self, q: u32) -> bool {
+        let (t, _) = self.quads[q as usize].edges[0];
+        !self.walk.used[t as usize] && self.stamp[q as usize] != self.current
+    }
+
+    /// Outer edge index of quad `q` that is triangle `t`'s slot `s`.
+    fn edge_index(&self, q: u32, t: u32, s: usize) -> usize {
+        self.quads[q as usize]
+            .edges
+            .iter()
+            .position(|&e| e == (t, s))
+            .expect("edge not on its quad (internal error)")
+    }
+
+    /// The free quad across outer edge `e` of `q`, and the index of that
+    /// edge in it.
+    fn across(&self, q: u32, e: usize) -> Option<(u32, usize)> {
+        let (t, s) = self.quads[q as usize].edges[e];
+        let n = self.walk.adj[t as usize][s];
+        if n == NO_NEIGHBOUR {
+            return None;
+        }
+        let qn = self.quad_of[n as usize];
+        if qn == NO_QUAD || !self.is_free(qn) {
+            return None;
+        }
+        Some((qn, self.edge_index(qn, n, slot_to(self.walk.adj, n, t))))
+    }
+
+    /// The maximal row of free quads through `(q, entry)`, in walking order.
+    fn row(&mut self, q: u32, entry: usize) -> Vec<Step> {
+        self.stamp[q as usize] = self.current;
+        let mut back = Vec::new();
+        let mut at = (q, entry);
+        while let Some((n, j)) = self.across(at.0, at.1) {
+            self.stamp[n as usize] = self.current;
+            back.push((n, (j + 2) % 4));
+            at = (n, j);
+        }
+        back.reverse();
+        back.push((q, entry));
+        let mut at = (q, entry);
+        while let Some((n, j)) = self.across(at.0, (at.1 + 2) % 4) {
+            self.stamp[n as usize] = self.current;
+            back.push((n, j));
+            at = (n, j);
+        }
+        back
+    }
+
+    /// The row next to `row` across side `side` (1 or 3, relative to each
+    /// quad's entry), if every quad there is free and they form a row.
+    fn next_row(&mut self, row: &[Step], side: usize) -> Option<Vec<Step>> {
+        let mut next = Vec::with_capacity(row.len());
+        for &(q, entry) in row {
+            let (n, j) = self.across(q, (entry + side) % 4)?;
+            // Keep the walking direction: the new entry edge meets the
+            // shared edge at the vertex the old entry edge meets it.
+            let e = if side == 1 { (j + 1) % 4 } else { (j + 3) % 4 };
+            next.push((n, e));
+        }
+        for w in next.windows(2) {
+            let ((a, ea), (b, _)) = (w[0], w[1]);
+            if a == b || self.across(a, (ea + 2) % 4).map(|x| x.0) != Some(b) {
+                return None;
+            }
+        }
+        let mut seen: Vec<u32> = next.iter().map(|s| s.0).collect();
+        seen.sort_unstable();
+        seen.dedup();
+        if seen.len() != next.len() {
+            return None;
+        }
+        for &(n, _) in &next {
+            self.stamp[n as usize] = self.current;
+        }
+        Some(next)
+    }
+
+    /// The largest rectangle of rows through `(q, entry)`.
+    fn patch(&mut self, q: u32, entry: usize) -> Vec<Vec<Step>> {
+        self.current += 1;
+        let middle = self.row(q, entry);
+        let mut rows = vec![middle.clone()];
+        for side in [1, 3] {
+            let mut last = middle.clone();
+            while let Some(next) = self.next_row(&last, side) {
+                rows.push(next.clone());
+                last = next;
+            }
+        }
+        rows
+    }
+}
+
+/// Pairs each triangle with the neighbour across its longest edge when that
+/// edge is the neighbour's longest too. Returns the quads and each
+/// triangle's quad (or `NO_QUAD`).
+fn pair_quads(walk: &Walk<'_>, positions: &[Vec3]) -> (Vec<Quad>, Vec<u32>) {
+    let tris = walk.tris;
+    let longest: Vec<usize> = tris
+        .iter()
+        .map(|t| {
+            let len = |s: usize| positions[t[s] as usize].distance_squared(positions[t[(s + 1) % 3] as usize]);
+            (0..3).max_by(|&a, &b| len(a).total_cmp(&len(b))).unwrap_or(0)
+        })
+        .collect();
+    let mut quads = Vec::new();
+    let mut quad_of = vec![NO_QUAD; tris.len()];
+    for t in 0..tris.len() as u32 {
+        if quad_of[t as usize] != NO_QUAD || !walk.is_free(t) {
+            continue;
+        }
+        let s = longest[t as usize];
+        let u = walk.adj[t as usize][s];
+        if !walk.is_free(u) || quad_of[u as usize] != NO_QUAD {
+            continue;
+        }
+        let su = longest[u as usize];
+        if walk.adj[u as usize][su] != t {
+            continue;
+        }
+        quad_of[t as usize] = quads.len() as u32;
+        quad_of[u as usize] = quads.len() as u32;
+        quads.push(Quad {
+            edges: [(t, (s + 1) % 3), (t, (s + 2) % 3), (u, (su + 1) % 3), (u, (su + 2) % 3)],
+        });
+    }
+    (quads, quad_of)
+}
+
+/// Runs the global pass, appending one path per patch row.
+///
+/// Cost: O(T · min_patch_quads) in the worst case (each rejected attempt
+/// looks at fewer than `min_patch_quads` quads per row stack), O(T) on
+/// quad-grid meshes where patches are accepted.
+pub(super) fn strip_patches(
+    walk: &mut Walk<'_>,
+    positions: &[Vec3],
+    min_patch_quads: usize,
+    paths: &mut Vec<Vec<u32>>,
+) {
+    let (quads, quad_of) = pair_quads(walk, positions);
+    let quad_count = quads.len();
+    let first_row = paths.len();
+    let mut q = Quads {
+        walk,
+        quads,
+        quad_of,
+        stamp: vec![0; quad_count],
+        current: 1,
+    };
+    for seed in 0..quad_count as u32 {
+        if !q.is_free(seed) {
+            continue;
+        }
+        let a = q.patch(seed, 0);
+        let b = q.patch(seed, 1);
+        let area = |rows: &Vec<Vec<Step>>| rows.len() * rows[0].len();
+        let best = if area(&b) > area(&a) { b } else { a };
+        if area(&best) < min_patch_quads {
+            continue;
+        }
+        for row in best {
+            let mut path = Vec::with_capacity(2 * row.len());
+            for (quad, entry) in row {
+                let edges = q.quads[quad as usize].edges;
+                let first = edges[entry].0;
+                let second = edges[(entry + 2) % 4].0;
+                path.extend([first, second]);
+            }
+            for &t in &path {
+                q.walk.take(t);
+            }
+            paths.push(path);
+        }
+    }
+    let mut rows = paths.split_off(first_row);
+    super::path::join_ends(&mut rows, walk.adj);
+    paths.extend(rows);
+    for path in &mut paths[first_row..] {
+        walk.grow_back(path);
+        path.reverse();
+        walk.grow_back(path);
+    }
+}
