@@ -84,7 +84,7 @@ struct StripsArgs {
     /// Smallest patch kept by the global pass, in quads.
     #[arg(long)]
     min_patch: Option<usize>,
-    /// Swap penalty of the local pass (see StripifyOptions).
+    /// Only this swap penalty in the local pass (see StripifyOptions).
     #[arg(long)]
     swap_penalty: Option<f32>,
     /// Do not join strips whose ends are neighbours.
@@ -123,7 +123,10 @@ fn strips(args: &StripsArgs) -> Result<()> {
     let options = StripifyOptions {
         patches: !args.no_patches,
         min_patch_quads: args.min_patch.unwrap_or(defaults.min_patch_quads),
-        swap_penalty: args.swap_penalty.unwrap_or(defaults.swap_penalty),
+        swap_penalties: match args.swap_penalty {
+            Some(p) => [Some(p), None],
+            None => defaults.swap_penalties,
+        },
         join_ends: !args.no_join,
     };
     let (ours, ms) = median_ms(args.repeat, || stripify(&mesh, &options));

@@ -36,7 +36,18 @@ impl TriangleAdjacency {
     pub fn new(mesh: &Mesh) -> TriangleAdjacency {
         let tris = &mesh.triangles;
         let n = mesh.vertex_count();
-        // Compressed vertex -> incident triangles table.
+        // Compressed vertex -> corners table. A corner of triangle `t` at
+        // vertex `a` stores the vertex after and before `a` in `t`, so that
+        // "t holds (a, b)" is `next == b` and "t holds (b, a)" is
+        // `prev == b`, without touching the triangle array.
+        #[derive(Clone, Copy, Default)]
+        struct Corner {
+            triangle: u32,
+            next: u32,
+            prev: u32,
+            /// Position of the vertex in its triangle.
+            k: u32,
+        }
         let mut start = vec![0u32; n + 1];
         for t in tris {
             for &v in t {
@@ -47,34 +58,38 @@ impl TriangleAdjacency {
             start[i + 1] += start[i];
         }
         let mut fill = start.clone();
-        let mut incident = vec![0u32; tris.len() * 3];
+        let mut corners = vec![Corner::default(); tris.len() * 3];
         for (ti, t) in tris.iter().enumerate() {
-            for &v in t {
-                incident[fill[v as usize] as usize] = ti as u32;
-                fill[v as usize] += 1;
+            for k in 0..3 {
+                let v = t[k] as usize;
+                corners[fill[v] as usize] = Corner {
+                    triangle: ti as u32,
+                    next: t[(k + 1) % 3],
+                    prev: t[(k + 2) % 3],
+                    k: k as u32,
+                };
+                fill[v] += 1;
             }
         }
 
-        let has_edge = |t: &[u32; 3], a: u32, b: u32| {
-            (t[0] == a && t[1] == b) || (t[1] == a && t[2] == b) || (t[2] == a && t[0] == b)
-        };
         let mut neighbours = vec![[NO_NEIGHBOUR; 3]; tris.len()];
         for (ti, t) in tris.iter().enumerate() {
             for slot in 0..3 {
+                if neighbours[ti][slot] != NO_NEIGHBOUR {
+                    continue; // set from the other side
+                }
                 let (a, b) = (t[slot], t[(slot + 1) % 3]);
-                let around = &incident[start[a as usize] as usize..start[a as usize + 1] as usize];
-                // Rank of `ti` among holders of (a, b); triangles around a
-                // are listed in increasing order, so ranks follow triangle order.
+                let around = &corners[start[a as usize] as usize..start[a as usize + 1] as usize];
+                // Rank of `ti` among holders of (a, b); corners around a are
+                // listed in increasing triangle order.
                 let rank = around
                     .iter()
-                    .filter(|&&u| u < ti as u32 && has_edge(&tris[u as usize], a, b))
+                    .filter(|c| c.next == b && c.triangle < ti as u32)
                     .count();
-                if let Some(&u) = around
-                    .iter()
-                    .filter(|&&u| u != ti as u32 && has_edge(&tris[u as usize], b, a))
-                    .nth(rank)
-                {
-                    neighbours[ti][slot] = u;
+                if let Some(c) = around.iter().filter(|c| c.prev == b).nth(rank) {
+                    neighbours[ti][slot] = c.triangle;
+                    // In that triangle (b, a) is the slot that ends at a.
+                    neighbours[c.triangle as usize][(c.k as usize + 2) % 3] = ti as u32;
                 }
             }
         }

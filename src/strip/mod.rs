@@ -11,7 +11,7 @@ pub mod encode;
 pub mod stats;
 pub mod stripify;
 
-pub use stripify::{stripify, StripifyOptions};
+pub use stripify::{stripify, stripify_with_adjacency, StripifyOptions};
 
 use crate::error::{Error, Result};
 

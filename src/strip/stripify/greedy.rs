@@ -14,19 +14,18 @@ use crate::mesh::NO_NEIGHBOUR;
 /// number of free neighbours (0–3). Entries are lazy: a triangle is pushed
 /// again when its count drops, and stale entries are skipped when popped,
 /// so each triangle is pushed at most four times.
-const LOOKAHEAD: f32 = 0.0;
-
+#[derive(Clone)]
 pub(super) struct Walk<'a> {
     pub(super) tris: &'a [[u32; 3]],
     pub(super) adj: &'a [[u32; 3]],
     pub(super) used: Vec<bool>,
     free_deg: Vec<u8>,
     buckets: [Vec<u32>; 4],
-    swap_penalty: f32,
+    pub(super) swap_penalty: f32,
 }
 
 impl<'a> Walk<'a> {
-    pub(super) fn new(tris: &'a [[u32; 3]], adj: &'a [[u32; 3]], swap_penalty: f32) -> Walk<'a> {
+    pub(super) fn new(tris: &'a [[u32; 3]], adj: &'a [[u32; 3]]) -> Walk<'a> {
         let free_deg: Vec<u8> = adj
             .iter()
             .map(|ns| ns.iter().filter(|&&n| n != NO_NEIGHBOUR).count() as u8)
@@ -42,7 +41,7 @@ impl<'a> Walk<'a> {
             used: vec![false; tris.len()],
             free_deg,
             buckets,
-            swap_penalty,
+            swap_penalty: 0.5,
         }
     }
 
@@ -74,15 +73,6 @@ impl<'a> Walk<'a> {
             }
         }
         None
-    }
-
-    /// Sum of the free-neighbour counts of `t`'s free neighbours.
-    fn neighbour_freedom(&self, t: u32) -> f32 {
-        self.adj[t as usize]
-            .iter()
-            .filter(|&&n| self.is_free(n))
-            .map(|&n| f32::from(self.free_deg[n as usize]))
-            .sum()
     }
 
     /// Extends `path` at its back until no free neighbour is left.
@@ -117,8 +107,7 @@ impl<'a> Walk<'a> {
                     _ => false,
                 };
                 let score = f32::from(self.free_deg[cand as usize])
-                    + if swap { self.swap_penalty } else { 0.0 }
-                    + LOOKAHEAD * self.neighbour_freedom(cand);
+                    + if swap { self.swap_penalty } else { 0.0 };
                 if best.is_none_or(|(b, _)| score < b) {
                     best = Some((score, cand));
                 }

@@ -14,7 +14,6 @@
 //! are found, each row strip grows at both ends by the local pass's rule.
 
 use super::greedy::Walk;
-use super::path::slot_to;
 use crate::mesh::NO_NEIGHBOUR;
 use glam::Vec3;
 
@@ -35,7 +34,11 @@ type Step = (u32, usize);
 struct Quads<'w, 'a> {
     walk: &'w mut Walk<'a>,
     quads: Vec<Quad>,
-    quad_of: Vec<u32>,
+    /// For each quad and outer edge: the quad across it and that edge's
+    /// index there, or `(NO_QUAD, 0)`.
+    links: Vec<[(u32, u8); 4]>,
+    /// Quads already stripped by an accepted patch.
+    taken: Vec<bool>,
     /// `stamp[q] == current` marks quads already in the patch being built.
     stamp: Vec<u32>,
     current: u32,
@@ -43,32 +46,37 @@ struct Quads<'w, 'a> {
 
 impl Quads<'_, '_> {
     fn is_free(&self, q: u32) -> bool {
-        let (t, _) = self.quads[q as usize].edges[0];
-        !self.walk.used[t as usize] && self.stamp[q as usize] != self.current
-    }
-
-    /// Outer edge index of quad `q` that is triangle `t`'s slot `s`.
-    fn edge_index(&self, q: u32, t: u32, s: usize) -> usize {
-        self.quads[q as usize]
-            .edges
-            .iter()
-            .position(|&e| e == (t, s))
-            .expect("edge not on its quad (internal error)")
+        !self.taken[q as usize] && self.stamp[q as usize] != self.current
     }
 
     /// The free quad across outer edge `e` of `q`, and the index of that
     /// edge in it.
     fn across(&self, q: u32, e: usize) -> Option<(u32, usize)> {
-        let (t, s) = self.quads[q as usize].edges[e];
-        let n = self.walk.adj[t as usize][s];
-        if n == NO_NEIGHBOUR {
-            return None;
+        let (n, j) = self.links[q as usize][e];
+        (n != NO_QUAD && self.is_free(n)).then_some((n, j as usize))
+    }
+
+    /// Length of the row through every quad along each axis (axis `a` is
+    /// entering through outer edge `a` or `a + 2`), ignoring stamps; an
+    /// upper bound for later rows since quads are only ever taken.
+    ///
+    /// Cost: O(quads): every quad is on one row per axis.
+    fn row_lengths(&mut self) -> Vec<[u32; 2]> {
+        let count = self.quads.len();
+        let mut lengths = vec![[0u32; 2]; count];
+        for axis in 0..2 {
+            for q in 0..count as u32 {
+                if lengths[q as usize][axis] != 0 {
+                    continue;
+                }
+                self.current += 1;
+                let row = self.row(q, axis);
+                for &(m, e) in &row {
+                    lengths[m as usize][e % 2] = row.len() as u32;
+                }
+            }
         }
-        let qn = self.quad_of[n as usize];
-        if qn == NO_QUAD || !self.is_free(qn) {
-            return None;
-        }
-        Some((qn, self.edge_index(qn, n, slot_to(self.walk.adj, n, t))))
+        lengths
     }
 
     /// The maximal row of free quads through `(q, entry)`, in walking order.
@@ -137,6 +145,35 @@ impl Quads<'_, '_> {
     }
 }
 
+/// The quad across each outer edge of each quad (see [`Quads::links`]).
+fn link_quads(walk: &Walk<'_>, quads: &[Quad], quad_of: &[u32]) -> Vec<[(u32, u8); 4]> {
+    quads
+        .iter()
+        .enumerate()
+        .map(|(qi, quad)| {
+            quad.edges.map(|(t, s)| {
+                let n = walk.adj[t as usize][s];
+                if n == NO_NEIGHBOUR || quad_of[n as usize] == NO_QUAD || quad_of[n as usize] == qi as u32 {
+                    return (NO_QUAD, 0);
+                }
+                let qn = quad_of[n as usize];
+                // The slot of `n` holding this very edge reversed (two
+                // triangles can be neighbours across more than one edge).
+                let b = walk.tris[t as usize][(s + 1) % 3];
+                let j = (0..3)
+                    .find(|&j| walk.adj[n as usize][j] == t && walk.tris[n as usize][j] == b)
+                    .expect("adjacency is not symmetric (internal error)");
+                let e = quads[qn as usize]
+                    .edges
+                    .iter()
+                    .position(|&x| x == (n, j))
+                    .expect("edge not on its quad (internal error)");
+                (qn, e as u8)
+            })
+        })
+        .collect()
+}
+
 /// Pairs each triangle with the neighbour across its longest edge when that
 /// edge is the neighbour's longest too. Returns the quads and each
 /// triangle's quad (or `NO_QUAD`).
@@ -187,25 +224,48 @@ pub(super) fn strip_patches(
     let (quads, quad_of) = pair_quads(walk, positions);
     let quad_count = quads.len();
     let first_row = paths.len();
+    let links = link_quads(walk, &quads, &quad_of);
     let mut q = Quads {
         walk,
         quads,
-        quad_of,
+        links,
+        taken: vec![false; quad_count],
         stamp: vec![0; quad_count],
         current: 1,
     };
-    for seed in 0..quad_count as u32 {
-        if !q.is_free(seed) {
+    // Quads inside a rejected attempt are not tried as seeds again: their
+    // rows were just measured and are shorter than the threshold allows.
+    // This keeps the pass O(T) in practice (bunny: 283 ms without it).
+    let mut tried = vec![false; quad_count];
+    let lengths = q.row_lengths();
+    // Largest possible patches first, as STRIPE does.
+    let bound = |seed: u32| {
+        let [l0, l1] = lengths[seed as usize];
+        l0 as usize * l1 as usize
+    };
+    let mut seeds: Vec<u32> = (0..quad_count as u32).filter(|&s| bound(s) >= min_patch_quads).collect();
+    seeds.sort_by_key(|&s| std::cmp::Reverse(bound(s)));
+    for seed in seeds {
+        let [l0, l1] = lengths[seed as usize];
+        // The rows of a patch cross the perpendicular row through the seed,
+        // so its area is at most the product of the two row lengths.
+        if tried[seed as usize] || (l0 as usize) * (l1 as usize) < min_patch_quads || !q.is_free(seed) {
             continue;
         }
         let a = q.patch(seed, 0);
         let b = q.patch(seed, 1);
         let area = |rows: &Vec<Vec<Step>>| rows.len() * rows[0].len();
-        let best = if area(&b) > area(&a) { b } else { a };
-        if area(&best) < min_patch_quads {
+        if area(&a).max(area(&b)) < min_patch_quads {
+            for &(quad, _) in a.iter().chain(&b).flatten() {
+                tried[quad as usize] = true;
+            }
             continue;
         }
+        let best = if area(&b) > area(&a) { b } else { a };
         for row in best {
+            for &(quad, _) in &row {
+                q.taken[quad as usize] = true;
+            }
             let mut path = Vec::with_capacity(2 * row.len());
             for (quad, entry) in row {
                 let edges = q.quads[quad as usize].edges;
