@@ -81,40 +81,46 @@ impl<'a> Walk<'a> {
     /// swap penalty if entering it needs a swap (see the `path` module:
     /// a swap is three consecutive shared edges around one vertex).
     pub(super) fn grow_back(&mut self, path: &mut Vec<u32>) {
+        let n = path.len();
+        let mut cur = path[n - 1];
+        // Entry slot of `cur` and the pivot at the previous triangle, carried
+        // from step to step.
+        let mut entry = (n >= 2).then(|| slot_to(self.adj, cur, path[n - 2]));
+        let mut last_pivot = (n >= 3).then(|| {
+            let prev = path[n - 2];
+            let a = slot_to(self.adj, prev, path[n - 3]);
+            let b = slot_to(self.adj, prev, cur);
+            pivot(&self.tris[prev as usize], a, b)
+        });
         loop {
-            let n = path.len();
-            let cur = path[n - 1];
             let t = &self.tris[cur as usize];
-            let entry = (n >= 2).then(|| slot_to(self.adj, cur, path[n - 2]));
-            // Pivot at the previous triangle, if there is one with an entry.
-            let last_pivot = (n >= 3).then(|| {
-                let prev = path[n - 2];
-                let a = slot_to(self.adj, prev, path[n - 3]);
-                let b = slot_to(self.adj, prev, cur);
-                pivot(&self.tris[prev as usize], a, b)
-            });
-            let mut best: Option<(f32, u32)> = None;
+            let ns = &self.adj[cur as usize];
+            let mut best: Option<(f32, usize)> = None;
             for s in 0..3 {
-                if Some(s) == entry {
-                    continue;
-                }
-                let cand = self.adj[cur as usize][s];
-                if !self.is_free(cand) {
+                let cand = ns[s];
+                if Some(s) == entry || !self.is_free(cand) {
                     continue;
                 }
                 let swap = match (entry, last_pivot) {
                     (Some(e), Some(p)) => pivot(t, e, s) == p,
                     _ => false,
                 };
-                let score = f32::from(self.free_deg[cand as usize])
-                    + if swap { self.swap_penalty } else { 0.0 };
+                let score = f32::from(self.free_deg[cand as usize]) + if swap { self.swap_penalty } else { 0.0 };
                 if best.is_none_or(|(b, _)| score < b) {
-                    best = Some((score, cand));
+                    best = Some((score, s));
                 }
             }
-            let Some((_, next)) = best else { return };
+            let Some((_, s)) = best else { return };
+            let next = ns[s];
+            last_pivot = entry.map(|e| pivot(t, e, s));
+            // The slot of `next` that holds this edge reversed.
+            let b = t[(s + 1) % 3];
+            let nt = &self.tris[next as usize];
+            entry = (0..3).find(|&j| self.adj[next as usize][j] == cur && nt[j] == b);
+            debug_assert!(entry.is_some(), "adjacency is not symmetric");
             self.take(next);
             path.push(next);
+            cur = next;
         }
     }
 }

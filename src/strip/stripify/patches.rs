@@ -102,29 +102,29 @@ impl Quads<'_, '_> {
 
     /// The row next to `row` across side `side` (1 or 3, relative to each
     /// quad's entry), if every quad there is free and they form a row.
+    /// Stamps the new row's quads when it succeeds.
     fn next_row(&mut self, row: &[Step], side: usize) -> Option<Vec<Step>> {
         let mut next = Vec::with_capacity(row.len());
         for &(q, entry) in row {
-            let (n, j) = self.across(q, (entry + side) % 4)?;
+            let Some((n, j)) = self.across(q, (entry + side) % 4) else {
+                break;
+            };
+            // Stamped at once, so a quad reached twice fails `across`.
+            self.stamp[n as usize] = self.current;
             // Keep the walking direction: the new entry edge meets the
             // shared edge at the vertex the old entry edge meets it.
             let e = if side == 1 { (j + 1) % 4 } else { (j + 3) % 4 };
             next.push((n, e));
         }
-        for w in next.windows(2) {
-            let ((a, ea), (b, _)) = (w[0], w[1]);
-            if a == b || self.across(a, (ea + 2) % 4).map(|x| x.0) != Some(b) {
-                return None;
+        let is_row = next.len() == row.len()
+            && next
+                .windows(2)
+                .all(|w| self.links[w[0].0 as usize][(w[0].1 + 2) % 4].0 == w[1].0);
+        if !is_row {
+            for &(n, _) in &next {
+                self.stamp[n as usize] = 0;
             }
-        }
-        let mut seen: Vec<u32> = next.iter().map(|s| s.0).collect();
-        seen.sort_unstable();
-        seen.dedup();
-        if seen.len() != next.len() {
             return None;
-        }
-        for &(n, _) in &next {
-            self.stamp[n as usize] = self.current;
         }
         Some(next)
     }
@@ -132,13 +132,12 @@ impl Quads<'_, '_> {
     /// The largest rectangle of rows through `(q, entry)`.
     fn patch(&mut self, q: u32, entry: usize) -> Vec<Vec<Step>> {
         self.current += 1;
-        let middle = self.row(q, entry);
-        let mut rows = vec![middle.clone()];
+        let mut rows = vec![self.row(q, entry)];
         for side in [1, 3] {
-            let mut last = middle.clone();
-            while let Some(next) = self.next_row(&last, side) {
-                rows.push(next.clone());
-                last = next;
+            let mut last = 0;
+            while let Some(next) = self.next_row(&rows[last], side) {
+                rows.push(next);
+                last = rows.len() - 1;
             }
         }
         rows
