@@ -1,11 +1,32 @@
-//! mts: continuous level of detail with multiresolution triangle strips.
+//! # mts — continuous level of detail with multiresolution triangle strips
+//!
+//! A mesh is loaded ([`mesh::io`]) or generated ([`mesh::generate`]), cut
+//! into generalized triangle strips ([`stripify`], a STRIPE-style hybrid
+//! search), and measured against meshoptimizer ([`peers::meshopt`]). Later
+//! stages (simplification, the multiresolution model, the renderer) build
+//! on these types; see `ARCHITECTURE.md` and `../shared/DESIGN.md`.
+//!
+//! ```
+//! use mts::mesh::generate::Generated;
+//! use mts::strip::sorted_canonical;
+//! use mts::{stripify, StripifyOptions};
+//!
+//! let mesh: mts::Mesh = "torus:20k".parse::<Generated>()?.build();
+//! let strips = stripify(&mesh, &StripifyOptions::default());
+//! // The strips draw exactly the mesh's triangles, with their winding...
+//! assert_eq!(sorted_canonical(&strips.triangles()), sorted_canonical(&mesh.triangles));
+//! // ...for far fewer indices than a triangle list (3 per triangle).
+//! assert!(strips.restart_index_count() < mesh.triangle_count() * 11 / 10);
+//! let gpu_buffer: Vec<u32> = strips.to_restart_u32();
+//! # assert!(!gpu_buffer.is_empty());
+//! # Ok::<(), mts::Error>(())
+//! ```
 
 pub mod error;
 pub mod mesh;
 pub mod peers;
+pub mod strip;
 
 pub use error::{Error, Place, Result};
 pub use mesh::Mesh;
-pub mod strip;
-
-pub use strip::{stripify, Strips, StripifyOptions};
+pub use strip::{stripify, StripifyOptions, Strips};

@@ -18,7 +18,13 @@ fn square_ply(format: &str) -> Vec<u8> {
          element extra 2\nproperty list int short stuff\n\
          end_header\n"
     );
-    let verts: [[f64; 3]; 5] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [2.0, 0.0, 0.0]];
+    let verts: [[f64; 3]; 5] = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [2.0, 0.0, 0.0],
+    ];
     let faces: [&[i32]; 2] = [&[0, 1, 2, 3], &[1, 4, 2]];
     let mut out = header.into_bytes();
     if format == "ascii" {
@@ -77,7 +83,11 @@ fn every_encoding_reads_the_same_mesh() {
         let raw = parse(&square_ply(format)).unwrap_or_else(|e| panic!("{format}: {e}"));
         assert_eq!(raw.positions.len(), 5, "{format}");
         assert_eq!(raw.positions[2], glam::Vec3::new(1.0, 1.0, 0.0), "{format}");
-        assert_eq!(raw.triangles, vec![[0, 1, 2], [0, 2, 3], [1, 4, 2]], "{format}");
+        assert_eq!(
+            raw.triangles,
+            vec![[0, 1, 2], [0, 2, 3], [1, 4, 2]],
+            "{format}"
+        );
     }
 }
 
@@ -97,7 +107,10 @@ fn tristrips_decode_with_alternating_winding_and_restarts() {
 fn real_bunny_reads_binary_or_ascii() {
     let path = Path::new("../shared/models/bunny_res4.ply");
     if !path.exists() {
-        eprintln!("skipped: {} not found (../shared/models is absent)", path.display());
+        eprintln!(
+            "skipped: {} not found (../shared/models is absent)",
+            path.display()
+        );
         return;
     }
     let (mesh, report) = load(path, LoadOptions::default()).unwrap();
@@ -118,7 +131,10 @@ fn truncated_binary_names_element_and_byte() {
     let cut = &bytes[..bytes.len() - 30];
     let e = error_of(cut);
     assert!(e.starts_with("test.ply: "), "{e}");
-    assert!(e.contains("byte 548, face 0") && e.contains("truncated"), "{e}");
+    assert!(
+        e.contains("byte 548, face 0") && e.contains("truncated"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -136,7 +152,10 @@ fn index_out_of_range_names_the_face() {
                 element face 2\nproperty list uchar int vertex_indices\nend_header\n\
                 0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 3\n";
     let e = error_of(text.as_bytes());
-    assert!(e.contains("face 1") && e.contains("line 14") && e.contains("index 3 out of range"), "{e}");
+    assert!(
+        e.contains("face 1") && e.contains("line 14") && e.contains("index 3 out of range"),
+        "{e}"
+    );
     let negative = text.replace("3 0 1 3\n", "3 0 -1 2\n");
     assert!(error_of(negative.as_bytes()).contains("index -1 out of range"));
 }
@@ -150,7 +169,10 @@ fn nan_and_infinite_coordinates_are_refused() {
              0 0 0\n1 {bad} 0\n0 1 0\n3 0 1 2\n"
         );
         let e = error_of(text.as_bytes());
-        assert!(e.contains("vertex 1") && e.contains("line 11") && e.contains("NaN or infinite"), "{bad}: {e}");
+        assert!(
+            e.contains("vertex 1") && e.contains("line 11") && e.contains("NaN or infinite"),
+            "{bad}: {e}"
+        );
     }
 }
 
@@ -165,7 +187,12 @@ fn absurd_header_counts_fail_fast_without_allocating() {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
     let e = error_of(&bytes);
-    assert!(e.contains("vertex 3") && e.contains("of 4000000000 declared") && e.contains("header count too large"), "{e}");
+    assert!(
+        e.contains("vertex 3")
+            && e.contains("of 4000000000 declared")
+            && e.contains("header count too large"),
+        "{e}"
+    );
 
     // A list claiming 4 billion items.
     let text = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
@@ -193,8 +220,12 @@ fn unknown_formats_are_named() {
     assert!(e.to_string().contains("binary_middle_endian"), "{e}");
     let e = parse(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n").unwrap_err();
     assert!(e.to_string().contains("end_header"), "{e}");
-    let e = parse(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n").unwrap_err();
-    assert!(e.to_string().contains("line 4") && e.to_string().contains("quad"), "{e}");
+    let e = parse(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n")
+        .unwrap_err();
+    assert!(
+        e.to_string().contains("line 4") && e.to_string().contains("quad"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -209,7 +240,10 @@ fn missing_coordinates_and_empty_meshes_are_refused() {
 #[test]
 fn non_numeric_token_is_named() {
     let e = error_of(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 zero 0\n");
-    assert!(e.contains("line 8") && e.contains("`zero` is not a number"), "{e}");
+    assert!(
+        e.contains("line 8") && e.contains("`zero` is not a number"),
+        "{e}"
+    );
 }
 
 #[test]

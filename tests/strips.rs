@@ -7,14 +7,16 @@ use mts::mesh::io::{load, LoadOptions};
 use mts::mesh::{generate, Mesh};
 use mts::strip::encode::RESTART_U32;
 use mts::strip::{decode_run, sorted_canonical};
-use mts::{peers, stripify, Strips, StripifyOptions};
+use mts::{peers, stripify, StripifyOptions, Strips};
 use proptest::prelude::*;
 use std::path::Path;
 
 fn mesh(triangles: Vec<[u32; 3]>) -> Mesh {
     let n = triangles.iter().flatten().max().map_or(0, |&m| m + 1);
     Mesh {
-        positions: (0..n).map(|i| Vec3::new(i as f32, (i * i % 7) as f32, 0.0)).collect(),
+        positions: (0..n)
+            .map(|i| Vec3::new(i as f32, (i * i % 7) as f32, 0.0))
+            .collect(),
         triangles,
     }
 }
@@ -24,14 +26,29 @@ fn check(mesh: &Mesh, options: &StripifyOptions) -> Strips {
     let strips = stripify(mesh, options);
     strips.validate();
     let expected = sorted_canonical(&mesh.triangles);
-    assert_eq!(sorted_canonical(&strips.triangles()), expected, "restart runs");
+    assert_eq!(
+        sorted_canonical(&strips.triangles()),
+        expected,
+        "restart runs"
+    );
     let mut stitched = Vec::new();
     decode_run(&strips.to_stitched(), &mut stitched);
     assert_eq!(sorted_canonical(&stitched), expected, "stitched buffer");
-    let again = Strips::from_restart_buffer(&strips.to_restart_u32(), RESTART_U32, strips.vertex_count()).unwrap();
+    let again =
+        Strips::from_restart_buffer(&strips.to_restart_u32(), RESTART_U32, strips.vertex_count())
+            .unwrap();
     assert_eq!(again, strips, "restart buffer round trip");
     if let Some(b16) = strips.to_restart_u16() {
-        let widened: Vec<u32> = b16.iter().map(|&i| if i == u16::MAX { RESTART_U32 } else { u32::from(i) }).collect();
+        let widened: Vec<u32> = b16
+            .iter()
+            .map(|&i| {
+                if i == u16::MAX {
+                    RESTART_U32
+                } else {
+                    u32::from(i)
+                }
+            })
+            .collect();
         assert_eq!(widened, strips.to_restart_u32(), "u16 buffer");
     }
     assert_eq!(strips.triangle_count(), mesh.triangle_count());
@@ -42,8 +59,16 @@ fn all_options() -> [StripifyOptions; 3] {
     let d = StripifyOptions::default();
     [
         d,
-        StripifyOptions { patches: false, join_ends: false, ..d },
-        StripifyOptions { min_patch_quads: 1, swap_penalties: [Some(3.0), None], ..d },
+        StripifyOptions {
+            patches: false,
+            join_ends: false,
+            ..d
+        },
+        StripifyOptions {
+            min_patch_quads: 1,
+            swap_penalties: [Some(3.0), None],
+            ..d
+        },
     ]
 }
 
@@ -59,8 +84,14 @@ fn one_triangle_is_one_run_of_three() {
 //  0 --- 1
 #[test]
 fn quad_is_one_run_of_four() {
-    let s = check(&mesh(vec![[0, 1, 2], [0, 2, 3]]), &StripifyOptions::default());
-    assert_eq!((s.run_count(), s.restart_index_count(), s.swap_count()), (1, 4, 0));
+    let s = check(
+        &mesh(vec![[0, 1, 2], [0, 2, 3]]),
+        &StripifyOptions::default(),
+    );
+    assert_eq!(
+        (s.run_count(), s.restart_index_count(), s.swap_count()),
+        (1, 4, 0)
+    );
 }
 
 //     5 --- 4
@@ -76,7 +107,11 @@ fn hexagon_fan_is_one_run_with_swaps() {
         assert_eq!(s.run_count(), 1);
         // Six triangles in one run: 8 vertices plus one swap per pivot repeat.
         assert_eq!(s.restart_index_count(), 8 + s.swap_count());
-        assert!(s.swap_count() >= 2, "a fan of six needs swaps: {:?}", s.run(0));
+        assert!(
+            s.swap_count() >= 2,
+            "a fan of six needs swaps: {:?}",
+            s.run(0)
+        );
     }
 }
 
@@ -108,15 +143,26 @@ fn torus_grid_strips_almost_sequentially() {
     let m = generate::torus(40, 20);
     let s = check(&m, &StripifyOptions::default());
     // 1,600 triangles on a regular grid: far below 1.1 indices each.
-    assert!(s.restart_index_count() < 1_760, "{}", s.restart_index_count());
+    assert!(
+        s.restart_index_count() < 1_760,
+        "{}",
+        s.restart_index_count()
+    );
 }
 
 #[test]
 fn generated_meshes_send_fewer_indices_than_meshoptimizer() {
-    for m in [generate::icosphere(20, 0.08, 1), generate::torus(100, 50), generate::grid(60, 40)] {
+    for m in [
+        generate::icosphere(20, 0.08, 1),
+        generate::torus(100, 50),
+        generate::grid(60, 40),
+    ] {
         let ours = check(&m, &StripifyOptions::default());
         let theirs = peers::meshopt::stripify(&m);
-        assert_eq!(sorted_canonical(&theirs.triangles()), sorted_canonical(&m.triangles));
+        assert_eq!(
+            sorted_canonical(&theirs.triangles()),
+            sorted_canonical(&m.triangles)
+        );
         assert!(
             ours.restart_index_count() < theirs.restart_index_count(),
             "{} triangles: {} indices against meshopt's {}",
@@ -131,56 +177,73 @@ fn generated_meshes_send_fewer_indices_than_meshoptimizer() {
 /// duplicated or fanned onto a shared edge (non-manifold), plus a second
 /// component, with vertex indices shuffled.
 fn random_mesh() -> impl Strategy<Value = Mesh> {
-    (2u32..12, 2u32..12, prop::collection::vec(0u8..16, 300), any::<u64>()).prop_map(|(w, h, dice, seed)| {
-        let mut tris = Vec::new();
-        let mut d = dice.iter().cycle();
-        let mut roll = || *d.next().unwrap();
-        let id = |x: u32, y: u32| y * (w + 1) + x;
-        for y in 0..h {
-            for x in 0..w {
-                let (a, b, c, e) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
-                let (t1, t2) = if roll() % 2 == 0 { ([a, b, c], [a, c, e]) } else { ([a, b, e], [b, c, e]) };
-                for t in [t1, t2] {
-                    match roll() {
-                        0 => {}                               // hole
-                        1 => tris.push([t[0], t[2], t[1]]), // flipped
-                        2 => {
-                            tris.push(t);
-                            tris.push(t); // duplicate
+    (
+        2u32..12,
+        2u32..12,
+        prop::collection::vec(0u8..16, 300),
+        any::<u64>(),
+    )
+        .prop_map(|(w, h, dice, seed)| {
+            let mut tris = Vec::new();
+            let mut d = dice.iter().cycle();
+            let mut roll = || *d.next().unwrap();
+            let id = |x: u32, y: u32| y * (w + 1) + x;
+            for y in 0..h {
+                for x in 0..w {
+                    let (a, b, c, e) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
+                    let (t1, t2) = if roll() % 2 == 0 {
+                        ([a, b, c], [a, c, e])
+                    } else {
+                        ([a, b, e], [b, c, e])
+                    };
+                    for t in [t1, t2] {
+                        match roll() {
+                            0 => {}                             // hole
+                            1 => tris.push([t[0], t[2], t[1]]), // flipped
+                            2 => {
+                                tris.push(t);
+                                tris.push(t); // duplicate
+                            }
+                            3 => {
+                                tris.push(t);
+                                // A fin: a third triangle on edge (t0, t1).
+                                tris.push([t[1], t[0], (w + 1) * (h + 1)]);
+                            }
+                            _ => tris.push(t),
                         }
-                        3 => {
-                            tris.push(t);
-                            // A fin: a third triangle on edge (t0, t1).
-                            tris.push([t[1], t[0], (w + 1) * (h + 1)]);
-                        }
-                        _ => tris.push(t),
                     }
                 }
             }
-        }
-        let base = (w + 1) * (h + 1) + 1;
-        tris.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
-        if tris.is_empty() {
-            tris.push([0, 1, 2]);
-        }
-        let n = base + 4;
-        // Shuffle vertex ids deterministically from the seed.
-        let mut perm: Vec<u32> = (0..n).collect();
-        let mut s = seed | 1;
-        for i in (1..perm.len()).rev() {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            perm.swap(i, (s % (i as u64 + 1)) as usize);
-        }
-        let tris: Vec<[u32; 3]> = tris.into_iter().map(|t| t.map(|v| perm[v as usize])).collect();
-        let raw = mts::mesh::RawMesh {
-            positions: (0..n).map(|i| Vec3::new(i as f32, (i * 7 % 13) as f32, (i % 3) as f32)).collect(),
-            triangles: tris,
-            degenerate_in_source: 0,
-        };
-        mts::mesh::clean(raw, Default::default(), "random").unwrap().0
-    })
+            let base = (w + 1) * (h + 1) + 1;
+            tris.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+            if tris.is_empty() {
+                tris.push([0, 1, 2]);
+            }
+            let n = base + 4;
+            // Shuffle vertex ids deterministically from the seed.
+            let mut perm: Vec<u32> = (0..n).collect();
+            let mut s = seed | 1;
+            for i in (1..perm.len()).rev() {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                perm.swap(i, (s % (i as u64 + 1)) as usize);
+            }
+            let tris: Vec<[u32; 3]> = tris
+                .into_iter()
+                .map(|t| t.map(|v| perm[v as usize]))
+                .collect();
+            let raw = mts::mesh::RawMesh {
+                positions: (0..n)
+                    .map(|i| Vec3::new(i as f32, (i * 7 % 13) as f32, (i % 3) as f32))
+                    .collect(),
+                triangles: tris,
+                degenerate_in_source: 0,
+            };
+            mts::mesh::clean(raw, Default::default(), "random")
+                .unwrap()
+                .0
+        })
 }
 
 proptest! {
@@ -197,7 +260,10 @@ proptest! {
 fn models() -> Option<Vec<std::path::PathBuf>> {
     let dir = Path::new("../shared/models");
     let Ok(entries) = std::fs::read_dir(dir) else {
-        eprintln!("skipped: {} not found; real-model checks need ../shared/models", dir.display());
+        eprintln!(
+            "skipped: {} not found; real-model checks need ../shared/models",
+            dir.display()
+        );
         return None;
     };
     let mut files: Vec<_> = entries
@@ -211,7 +277,11 @@ fn models() -> Option<Vec<std::path::PathBuf>> {
 #[test]
 fn every_shared_model_decodes_exactly_and_beats_meshoptimizer() {
     let Some(files) = models() else { return };
-    assert!(files.len() >= 20, "expected the 20 shared models, found {}", files.len());
+    assert!(
+        files.len() >= 20,
+        "expected the 20 shared models, found {}",
+        files.len()
+    );
     for path in files {
         let (m, _) = load(&path, LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
         let ours = check(&m, &StripifyOptions::default());
@@ -223,9 +293,16 @@ fn every_shared_model_decodes_exactly_and_beats_meshoptimizer() {
             a as f64 / m.triangle_count() as f64,
             b as f64 / m.triangle_count() as f64
         );
-        assert!(a < b, "{}: {a} indices against meshopt's {b}", path.display());
+        assert!(
+            a < b,
+            "{}: {a} indices against meshopt's {b}",
+            path.display()
+        );
         if path.ends_with("bunny.ply") {
-            assert!(a as f64 <= 1.20 * m.triangle_count() as f64, "bunny: {a} indices");
+            assert!(
+                a as f64 <= 1.20 * m.triangle_count() as f64,
+                "bunny: {a} indices"
+            );
         }
     }
 }

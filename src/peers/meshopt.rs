@@ -16,8 +16,10 @@ pub const CACHE_SIZE: u32 = 16;
 pub fn stripify(mesh: &Mesh) -> Strips {
     let n = mesh.vertex_count();
     let ordered = meshopt::optimize_vertex_cache_strip(&mesh.index_list(), n);
-    let buffer = meshopt::stripify(&ordered, n, RESTART_U32).expect("meshopt::stripify failed on a valid mesh");
-    Strips::from_restart_buffer(&buffer, RESTART_U32, n as u32).expect("meshopt produced an invalid strip")
+    let buffer = meshopt::stripify(&ordered, n, RESTART_U32)
+        .expect("meshopt::stripify failed on a valid mesh");
+    Strips::from_restart_buffer(&buffer, RESTART_U32, n as u32)
+        .expect("meshopt produced an invalid strip")
 }
 
 /// Average cache miss ratio of a triangle list in meshoptimizer's FIFO

@@ -34,7 +34,13 @@ impl Strips {
         Some(
             self.to_restart_u32()
                 .into_iter()
-                .map(|i| if i == RESTART_U32 { RESTART_U16 } else { i as u16 })
+                .map(|i| {
+                    if i == RESTART_U32 {
+                        RESTART_U16
+                    } else {
+                        i as u16
+                    }
+                })
                 .collect(),
         )
     }
@@ -70,18 +76,28 @@ mod tests {
     use crate::strip::decode_run;
 
     fn strips() -> Strips {
-        Strips::from_runs([&[0, 1, 2, 3, 4][..], &[5, 6, 7, 8][..], &[1, 5, 9][..]], 10).unwrap()
+        Strips::from_runs(
+            [&[0, 1, 2, 3, 4][..], &[5, 6, 7, 8][..], &[1, 5, 9][..]],
+            10,
+        )
+        .unwrap()
     }
 
     #[test]
     fn restart_encodings_agree() {
         let s = strips();
         let b32 = s.to_restart_u32();
-        assert_eq!(b32, vec![0, 1, 2, 3, 4, RESTART_U32, 5, 6, 7, 8, RESTART_U32, 1, 5, 9]);
+        assert_eq!(
+            b32,
+            vec![0, 1, 2, 3, 4, RESTART_U32, 5, 6, 7, 8, RESTART_U32, 1, 5, 9]
+        );
         let b16 = s.to_restart_u16().unwrap();
         assert_eq!(b16.len(), b32.len());
         assert_eq!(b16[5], RESTART_U16);
-        assert!(Strips::from_runs([&[0, 1, 70_000][..]], 70_001).unwrap().to_restart_u16().is_none());
+        assert!(Strips::from_runs([&[0, 1, 70_000][..]], 70_001)
+            .unwrap()
+            .to_restart_u16()
+            .is_none());
     }
 
     #[test]

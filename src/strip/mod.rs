@@ -38,7 +38,10 @@ impl Strips {
     /// # Errors
     /// [`Error::InvalidArgument`] if a run is shorter than 3 or an index is out
     /// of range.
-    pub fn from_runs<'a>(runs: impl IntoIterator<Item = &'a [u32]>, vertex_count: u32) -> Result<Strips> {
+    pub fn from_runs<'a>(
+        runs: impl IntoIterator<Item = &'a [u32]>,
+        vertex_count: u32,
+    ) -> Result<Strips> {
         let mut strips = Strips {
             indices: Vec::new(),
             starts: vec![0],
@@ -60,7 +63,10 @@ impl Strips {
     /// # Errors
     /// As [`Strips::from_runs`].
     pub fn from_restart_buffer(buffer: &[u32], restart: u32, vertex_count: u32) -> Result<Strips> {
-        Strips::from_runs(buffer.split(|&i| i == restart).filter(|r| !r.is_empty()), vertex_count)
+        Strips::from_runs(
+            buffer.split(|&i| i == restart).filter(|r| !r.is_empty()),
+            vertex_count,
+        )
     }
 
     /// Number of runs.
@@ -134,7 +140,10 @@ impl Strips {
     fn check(&self) -> Result<()> {
         for (i, run) in self.runs().enumerate() {
             if run.len() < 3 {
-                return Err(Error::InvalidArgument(format!("run {i} has {} vertices", run.len())));
+                return Err(Error::InvalidArgument(format!(
+                    "run {i} has {} vertices",
+                    run.len()
+                )));
             }
             if let Some(v) = run.iter().find(|&&v| v >= self.vertex_count) {
                 return Err(Error::InvalidArgument(format!(

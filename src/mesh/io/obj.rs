@@ -24,7 +24,6 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..tobj::LoadOptions::default()
     };
     let mut reader = bytes;
     let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
@@ -69,7 +68,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
                 && words[1..]
                     .iter()
                     .take(3)
-                    .any(|w| w.parse::<f32>().map_or(false, |x| !x.is_finite()))
+                    .any(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite()))
         });
         return Err(Error::Parse {
             file: path.to_owned(),

@@ -14,7 +14,7 @@
 use crate::error::{Error, Place, Result};
 use crate::mesh::RawMesh;
 use glam::Vec3;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Longest header accepted, in bytes; real headers are a few hundred.
 const MAX_HEADER_BYTES: usize = 64 * 1024;
@@ -140,7 +140,7 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<RawMesh> {
         .find(|e| e.name == "vertex")
         .map(|e| e.count)
         .ok_or_else(|| Error::Parse {
-            file: file.clone(),
+            file: file.to_owned(),
             place: Place::line(1),
             message: "no `vertex` element in the header".into(),
         })?;
@@ -401,14 +401,14 @@ fn read_element(
     element: &Element,
     vertex_count: u64,
     raw: &mut RawMesh,
-    file: &PathBuf,
+    file: &Path,
 ) -> Result<()> {
     if element.properties.is_empty() {
         // Nothing to read, whatever the count says.
         return Ok(());
     }
     let header_err = |message: String| Error::Parse {
-        file: file.clone(),
+        file: file.to_owned(),
         place: Place::line(element.line),
         message,
     };
@@ -486,7 +486,7 @@ fn read_element(
                     ReadError::Malformed(m) => format!("property `{}`: {m}", property.name),
                 };
                 Error::Parse {
-                    file: file.clone(),
+                    file: file.to_owned(),
                     place: reader.place(&element.name, index),
                     message,
                 }
@@ -520,7 +520,7 @@ fn read_element(
             let p = Vec3::new(coords[0] as f32, coords[1] as f32, coords[2] as f32);
             if !p.is_finite() {
                 return Err(Error::Parse {
-                    file: file.clone(),
+                    file: file.to_owned(),
                     place: reader.place("vertex", index),
                     message: format!(
                         "coordinate is NaN or infinite (or beyond f32 range): {coords:?}"
@@ -531,10 +531,10 @@ fn read_element(
         } else if roles.contains(&Role::Indices) {
             let out_of_range = list
                 .iter()
-                .find(|&&i| !(0..vertex_count as i64).contains(&i) && !(is_strip && i == -1));
+                .find(|&&i| !((0..vertex_count as i64).contains(&i) || (is_strip && i == -1)));
             if let Some(&i) = out_of_range {
                 return Err(Error::Parse {
-                    file: file.clone(),
+                    file: file.to_owned(),
                     place: reader.place(&element.name, index),
                     message: format!("vertex index {i} out of range (the header declares {vertex_count} vertices)"),
                 });

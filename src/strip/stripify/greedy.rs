@@ -96,8 +96,7 @@ impl<'a> Walk<'a> {
             let t = &self.tris[cur as usize];
             let ns = &self.adj[cur as usize];
             let mut best: Option<(f32, usize)> = None;
-            for s in 0..3 {
-                let cand = ns[s];
+            for (s, &cand) in ns.iter().enumerate() {
                 if Some(s) == entry || !self.is_free(cand) {
                     continue;
                 }
@@ -105,7 +104,8 @@ impl<'a> Walk<'a> {
                     (Some(e), Some(p)) => pivot(t, e, s) == p,
                     _ => false,
                 };
-                let score = f32::from(self.free_deg[cand as usize]) + if swap { self.swap_penalty } else { 0.0 };
+                let score = f32::from(self.free_deg[cand as usize])
+                    + if swap { self.swap_penalty } else { 0.0 };
                 if best.is_none_or(|(b, _)| score < b) {
                     best = Some((score, s));
                 }

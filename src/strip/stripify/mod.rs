@@ -13,16 +13,35 @@
 //! components need no special case, and every triangle keeps its winding.
 
 mod greedy;
-mod path;
 mod patches;
+mod path;
 
 use super::Strips;
 use crate::mesh::{Mesh, TriangleAdjacency};
 use greedy::Walk;
 
-/// Meshes with at least this many triangles run the local-pass attempts on
-/// two threads.
+/// Meshes with at least this many triangles run the patch start and the
+/// plain start on two threads (a spawn costs tens of microseconds).
 const PARALLEL_MIN_TRIANGLES: usize = 20_000;
+
+/// Penalties after the first are tried only on meshes below this size. On
+/// the shared models the second penalty won only below it (`non_manif_hole`,
+/// `3holes`, `teapot`); penalty 0.5 won on all nine larger ones, where an
+/// extra run would add a third of the time.
+const EXTRA_PENALTIES_MAX_TRIANGLES: usize = 20_000;
+
+/// A candidate result: all runs back to back and where each starts.
+struct Encoded {
+    indices: Vec<u32>,
+    starts: Vec<u32>,
+}
+
+impl Encoded {
+    /// Indices sent with restart encoding (one restart per run boundary).
+    fn cost(&self) -> usize {
+        self.indices.len() + self.starts.len()
+    }
+}
 
 /// Tuning of [`stripify`]. The defaults were chosen by `mts strips` over
 /// every model in `../shared/models` and the generated meshes (see the
@@ -37,12 +56,14 @@ pub struct StripifyOptions {
     /// Costs of a swap, in "free neighbours", tried by the local pass when it
     /// picks the next triangle: score = free neighbours of the candidate +
     /// the penalty if it needs a swap; lowest wins. The local pass runs once
-    /// per penalty from the same state and the run with fewest indices is
-    /// kept. Below 1 means "fewest free neighbours first, swap as
+    /// per penalty from the untouched mesh, and with the first penalty after
+    /// the global pass; the run with fewest indices is kept. Below 1 means "fewest free neighbours first, swap as
     /// tie-break" (the rule of the STRIPE paper; best on 16 of the 20 shared
     /// models); above 1 avoids swaps unless the other side is two
     /// neighbours freer (best on `non_manif_hole.ply`: 1.221 against 1.314
-    /// indices per triangle). Empty means `[0.5]`.
+    /// indices per triangle). Empty means `[0.5]`. Meshes of 20K triangles
+    /// or more use only the first penalty (see
+    /// `EXTRA_PENALTIES_MAX_TRIANGLES`).
     pub swap_penalties: [Option<f32>; 2],
     /// Join strips whose end triangles are neighbours after both passes.
     pub join_ends: bool,
@@ -80,69 +101,81 @@ pub fn stripify_with_adjacency(
     options: &StripifyOptions,
 ) -> Strips {
     let fresh = Walk::new(&mesh.triangles, &adjacency.neighbours);
-    // Starting states for the local pass: after the global pass, and (when
-    // the global pass ran) without it. Patches win on some scans (bunny:
-    // 1.199 against 1.204 indices per triangle) and lose on meshes the
-    // greedy pass already walks in one strip (icosphere: 1.031 against
-    // 1.008), so both are tried and the cheaper result is kept.
-    let mut starts_states: Vec<(Walk<'_>, Vec<Vec<u32>>)> = Vec::with_capacity(2);
-    if options.patches {
+    let penalties: Vec<f32> = options.swap_penalties.iter().flatten().copied().collect();
+    let mut penalties = if penalties.is_empty() {
+        vec![0.5]
+    } else {
+        penalties
+    };
+    if mesh.triangle_count() >= EXTRA_PENALTIES_MAX_TRIANGLES {
+        penalties.truncate(1);
+    }
+
+    // One run of the local pass from `walk` (with `done` paths already
+    // made), joined and encoded: (indices, run starts).
+    let attempt = |walk: &Walk<'_>, done: &[Vec<u32>], penalty: f32| -> Encoded {
+        let mut paths = done.to_vec();
+        let mut w = walk.clone();
+        w.swap_penalty = penalty;
+        greedy::strip_rest(&mut w, &mut paths);
+        if options.join_ends {
+            path::join_ends(&mut paths, &adjacency.neighbours);
+        }
+        let mut indices = Vec::with_capacity(mesh.triangle_count() * 6 / 5 + 3 * paths.len());
+        let mut starts = Vec::with_capacity(paths.len() + 1);
+        starts.push(0);
+        for p in &paths {
+            path::encode(p, &mesh.triangles, &adjacency.neighbours, &mut indices);
+            starts.push(indices.len() as u32);
+        }
+        Encoded { indices, starts }
+    };
+    // From the untouched mesh, with every penalty.
+    let from_fresh = || {
+        penalties
+            .iter()
+            .map(|&p| attempt(&fresh, &[], p))
+            .min_by_key(Encoded::cost)
+            .expect("at least one penalty")
+    };
+    // After the global pass, with the first penalty. Patches win on some
+    // scans (bunny: 1.199 against 1.204 indices per triangle) and lose on
+    // meshes the local pass walks in one strip (icosphere: 1.031 against
+    // 1.008), so both starts are tried and the cheaper result is kept.
+    let from_patches = || {
+        if !options.patches {
+            return None;
+        }
         let mut walk = fresh.clone();
         let mut paths = Vec::new();
-        patches::strip_patches(&mut walk, &mesh.positions, options.min_patch_quads, &mut paths);
-        if !paths.is_empty() {
-            starts_states.push((walk, paths));
-        }
-    }
-    starts_states.push((fresh, Vec::new()));
-    let penalties: Vec<f32> = options.swap_penalties.iter().flatten().copied().collect();
-    let penalties = if penalties.is_empty() { vec![0.5] } else { penalties };
-    let attempts: Vec<(usize, f32)> = (0..starts_states.len())
-        .flat_map(|state| penalties.iter().map(move |&p| (state, p)))
-        .collect();
-    let run = |attempts: &[(usize, f32)]| -> Option<(Vec<u32>, Vec<u32>)> {
-        let mut best: Option<(Vec<u32>, Vec<u32>)> = None;
-        for &(state, penalty) in attempts {
-            let (walk, patch_paths) = &starts_states[state];
-            let mut paths = patch_paths.clone();
-            let mut w = walk.clone();
-            w.swap_penalty = penalty;
-            greedy::strip_rest(&mut w, &mut paths);
-            if options.join_ends {
-                path::join_ends(&mut paths, &adjacency.neighbours);
-            }
-            let mut indices = Vec::with_capacity(mesh.triangle_count() * 6 / 5 + 3 * paths.len());
-            let mut starts = Vec::with_capacity(paths.len() + 1);
-            starts.push(0);
-            for p in &paths {
-                path::encode(p, &mesh.triangles, &adjacency.neighbours, &mut indices);
-                starts.push(indices.len() as u32);
-            }
-            if best.as_ref().is_none_or(|(bi, bs)| indices.len() + starts.len() < bi.len() + bs.len()) {
-                best = Some((indices, starts));
-            }
-        }
-        best
+        patches::strip_patches(
+            &mut walk,
+            &mesh.positions,
+            options.min_patch_quads,
+            &mut paths,
+        );
+        (!paths.is_empty()).then(|| attempt(&walk, &paths, penalties[0]))
     };
-    // Attempts are independent: split them over two threads when the mesh
-    // is large enough to pay for the spawn (measured: ~50 µs per thread).
-    let best = if mesh.triangle_count() >= PARALLEL_MIN_TRIANGLES && attempts.len() > 1 {
-        let (left, right) = attempts.split_at(attempts.len() / 2);
-        let (a, b) = std::thread::scope(|scope| {
-            let handle = scope.spawn(|| run(left));
-            let b = run(right);
-            (handle.join().expect("stripify worker panicked"), b)
-        });
-        match (a, b) {
-            (Some(a), Some(b)) => Some(if a.0.len() + a.1.len() <= b.0.len() + b.1.len() { a } else { b }),
-            (a, b) => a.or(b),
-        }
+    // The two are independent: on two threads when the mesh is large enough
+    // to pay for the spawn.
+    let (patched, plain) = if mesh.triangle_count() >= PARALLEL_MIN_TRIANGLES && options.patches {
+        std::thread::scope(|scope| {
+            let handle = scope.spawn(from_patches);
+            let plain = from_fresh();
+            (handle.join().expect("stripify worker panicked"), plain)
+        })
     } else {
-        run(&attempts)
+        (from_patches(), from_fresh())
     };
-    let (indices, starts) = best.expect("at least one penalty is tried");
+    let best = match patched {
+        Some(p) if p.cost() < plain.cost() => p,
+        _ => plain,
+    };
+    let Encoded { indices, starts } = best;
     let strips = Strips::from_runs(
-        starts.windows(2).map(|w| &indices[w[0] as usize..w[1] as usize]),
+        starts
+            .windows(2)
+            .map(|w| &indices[w[0] as usize..w[1] as usize]),
         mesh.vertex_count() as u32,
     )
     .expect("stripify produced an invalid run (internal error)");

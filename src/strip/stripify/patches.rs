@@ -145,30 +145,37 @@ impl Quads<'_, '_> {
 }
 
 /// The quad across each outer edge of each quad (see [`Quads::links`]).
-fn link_quads(walk: &Walk<'_>, quads: &[Quad], quad_of: &[u32]) -> Vec<[(u32, u8); 4]> {
+fn link_quads(
+    walk: &Walk<'_>,
+    quads: &[Quad],
+    quad_of: &[u32],
+    edge_of: &[[u8; 3]],
+) -> Vec<[(u32, u8); 4]> {
     quads
         .iter()
         .enumerate()
         .map(|(qi, quad)| {
-            quad.edges.map(|(t, s)| {
+            let mut links = [(NO_QUAD, 0u8); 4];
+            for (link, &(t, s)) in links.iter_mut().zip(&quad.edges) {
                 let n = walk.adj[t as usize][s];
-                if n == NO_NEIGHBOUR || quad_of[n as usize] == NO_QUAD || quad_of[n as usize] == qi as u32 {
-                    return (NO_QUAD, 0);
+                if n == NO_NEIGHBOUR {
+                    continue;
                 }
                 let qn = quad_of[n as usize];
+                if qn == NO_QUAD || qn == qi as u32 {
+                    continue;
+                }
                 // The slot of `n` holding this very edge reversed (two
                 // triangles can be neighbours across more than one edge).
                 let b = walk.tris[t as usize][(s + 1) % 3];
+                let ns = &walk.adj[n as usize];
+                let nt = &walk.tris[n as usize];
                 let j = (0..3)
-                    .find(|&j| walk.adj[n as usize][j] == t && walk.tris[n as usize][j] == b)
+                    .find(|&j| ns[j] == t && nt[j] == b)
                     .expect("adjacency is not symmetric (internal error)");
-                let e = quads[qn as usize]
-                    .edges
-                    .iter()
-                    .position(|&x| x == (n, j))
-                    .expect("edge not on its quad (internal error)");
-                (qn, e as u8)
-            })
+                *link = (qn, edge_of[n as usize][j]);
+            }
+            links
         })
         .collect()
 }
@@ -176,17 +183,24 @@ fn link_quads(walk: &Walk<'_>, quads: &[Quad], quad_of: &[u32]) -> Vec<[(u32, u8
 /// Pairs each triangle with the neighbour across its longest edge when that
 /// edge is the neighbour's longest too. Returns the quads and each
 /// triangle's quad (or `NO_QUAD`).
-fn pair_quads(walk: &Walk<'_>, positions: &[Vec3]) -> (Vec<Quad>, Vec<u32>) {
+fn pair_quads(walk: &Walk<'_>, positions: &[Vec3]) -> (Vec<Quad>, Vec<u32>, Vec<[u8; 3]>) {
     let tris = walk.tris;
     let longest: Vec<usize> = tris
         .iter()
         .map(|t| {
-            let len = |s: usize| positions[t[s] as usize].distance_squared(positions[t[(s + 1) % 3] as usize]);
-            (0..3).max_by(|&a, &b| len(a).total_cmp(&len(b))).unwrap_or(0)
+            let len = |s: usize| {
+                positions[t[s] as usize].distance_squared(positions[t[(s + 1) % 3] as usize])
+            };
+            (0..3)
+                .max_by(|&a, &b| len(a).total_cmp(&len(b)))
+                .unwrap_or(0)
         })
         .collect();
     let mut quads = Vec::new();
     let mut quad_of = vec![NO_QUAD; tris.len()];
+    // Outer edge index of each triangle slot in its quad (the diagonal's
+    // slot is never looked up).
+    let mut edge_of = vec![[0u8; 3]; tris.len()];
     for t in 0..tris.len() as u32 {
         if quad_of[t as usize] != NO_QUAD || !walk.is_free(t) {
             continue;
@@ -203,10 +217,19 @@ fn pair_quads(walk: &Walk<'_>, positions: &[Vec3]) -> (Vec<Quad>, Vec<u32>) {
         quad_of[t as usize] = quads.len() as u32;
         quad_of[u as usize] = quads.len() as u32;
         quads.push(Quad {
-            edges: [(t, (s + 1) % 3), (t, (s + 2) % 3), (u, (su + 1) % 3), (u, (su + 2) % 3)],
+            edges: [
+                (t, (s + 1) % 3),
+                (t, (s + 2) % 3),
+                (u, (su + 1) % 3),
+                (u, (su + 2) % 3),
+            ],
         });
+        edge_of[t as usize][(s + 1) % 3] = 0;
+        edge_of[t as usize][(s + 2) % 3] = 1;
+        edge_of[u as usize][(su + 1) % 3] = 2;
+        edge_of[u as usize][(su + 2) % 3] = 3;
     }
-    (quads, quad_of)
+    (quads, quad_of, edge_of)
 }
 
 /// Runs the global pass, appending one path per patch row.
@@ -220,10 +243,10 @@ pub(super) fn strip_patches(
     min_patch_quads: usize,
     paths: &mut Vec<Vec<u32>>,
 ) {
-    let (quads, quad_of) = pair_quads(walk, positions);
+    let (quads, quad_of, edge_of) = pair_quads(walk, positions);
     let quad_count = quads.len();
     let first_row = paths.len();
-    let links = link_quads(walk, &quads, &quad_of);
+    let links = link_quads(walk, &quads, &quad_of, &edge_of);
     let mut q = Quads {
         walk,
         quads,
@@ -242,13 +265,18 @@ pub(super) fn strip_patches(
         let [l0, l1] = lengths[seed as usize];
         l0 as usize * l1 as usize
     };
-    let mut seeds: Vec<u32> = (0..quad_count as u32).filter(|&s| bound(s) >= min_patch_quads).collect();
+    let mut seeds: Vec<u32> = (0..quad_count as u32)
+        .filter(|&s| bound(s) >= min_patch_quads)
+        .collect();
     seeds.sort_by_key(|&s| std::cmp::Reverse(bound(s)));
     for seed in seeds {
         let [l0, l1] = lengths[seed as usize];
         // The rows of a patch cross the perpendicular row through the seed,
         // so its area is at most the product of the two row lengths.
-        if tried[seed as usize] || (l0 as usize) * (l1 as usize) < min_patch_quads || !q.is_free(seed) {
+        if tried[seed as usize]
+            || (l0 as usize) * (l1 as usize) < min_patch_quads
+            || !q.is_free(seed)
+        {
             continue;
         }
         let a = q.patch(seed, 0);
