@@ -57,23 +57,52 @@ impl Quads<'_, '_> {
     }
 
     /// Length of the row through every quad along each axis (axis `a` is
-    /// entering through outer edge `a` or `a + 2`), ignoring stamps; an
-    /// upper bound for later rows since quads are only ever taken.
+    /// entering through outer edge `a` or `a + 2`), before any quad is
+    /// taken; an upper bound later, since quads are only ever taken.
     ///
-    /// Cost: O(quads): every quad is on one row per axis.
-    fn row_lengths(&mut self) -> Vec<[u32; 2]> {
-        let count = self.quads.len();
-        let mut lengths = vec![[0u32; 2]; count];
+    /// (quad, axis) pairs with their links form a graph of degree at most 2
+    /// whose components are the rows (paths or cycles), so each component
+    /// is walked twice, to count and to write, without allocating.
+    ///
+    /// Cost: O(quads).
+    fn row_lengths(&self) -> Vec<[u32; 2]> {
+        let links = &self.links;
+        let mut lengths = vec![[0u32; 2]; self.quads.len()];
+        // Walks the row through (q, axis): forward through edge entry + 2,
+        // then (unless it closed a cycle) backward through the entry edge,
+        // calling `visit` on every other member.
+        let walk = |q: u32, axis: usize, visit: &mut dyn FnMut(u32, usize)| {
+            let mut at = (q, axis);
+            loop {
+                let (n, j) = links[at.0 as usize][(at.1 + 2) % 4];
+                if n == NO_QUAD {
+                    break;
+                }
+                if (n, j as usize % 2) == (q, axis) {
+                    return;
+                }
+                visit(n, j as usize % 2);
+                at = (n, j as usize);
+            }
+            let mut at = (q, axis);
+            loop {
+                let (n, j) = links[at.0 as usize][at.1];
+                if n == NO_QUAD {
+                    break;
+                }
+                visit(n, j as usize % 2);
+                at = (n, (j as usize + 2) % 4);
+            }
+        };
         for axis in 0..2 {
-            for q in 0..count as u32 {
+            for q in 0..self.quads.len() as u32 {
                 if lengths[q as usize][axis] != 0 {
                     continue;
                 }
-                self.current += 1;
-                let row = self.row(q, axis);
-                for &(m, e) in &row {
-                    lengths[m as usize][e % 2] = row.len() as u32;
-                }
+                let mut count = 1u32;
+                walk(q, axis, &mut |_, _| count += 1);
+                lengths[q as usize][axis] = count;
+                walk(q, axis, &mut |m, a| lengths[m as usize][a] = count);
             }
         }
         lengths
