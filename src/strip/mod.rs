@@ -60,7 +60,12 @@ impl Strips {
     /// Builds strips from parts the caller has checked: runs back to back,
     /// their offsets (`starts[0] == 0`, one more than runs) and the number
     /// of triangles they draw. Checked in debug builds.
-    pub(crate) fn from_parts(indices: Vec<u32>, starts: Vec<u32>, vertex_count: u32, triangle_count: usize) -> Strips {
+    pub(crate) fn from_parts(
+        indices: Vec<u32>,
+        starts: Vec<u32>,
+        vertex_count: u32,
+        triangle_count: usize,
+    ) -> Strips {
         let strips = Strips {
             indices,
             starts,
@@ -70,7 +75,10 @@ impl Strips {
         #[cfg(debug_assertions)]
         {
             strips.validate();
-            assert_eq!(strips.runs().map(run_triangle_count).sum::<usize>(), triangle_count);
+            assert_eq!(
+                strips.runs().map(run_triangle_count).sum::<usize>(),
+                triangle_count
+            );
         }
         strips
     }

@@ -173,5 +173,10 @@ pub fn stripify_with_adjacency(
     };
     let Encoded { indices, starts } = best;
     // Every path draws each of its triangles once, so the runs draw them all.
-    Strips::from_parts(indices, starts, mesh.vertex_count() as u32, mesh.triangle_count())
+    Strips::from_parts(
+        indices,
+        starts,
+        mesh.vertex_count() as u32,
+        mesh.triangle_count(),
+    )
 }
