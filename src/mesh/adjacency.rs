@@ -80,17 +80,38 @@ impl TriangleAdjacency {
                 }
                 let (a, b) = (t[slot], t[(slot + 1) % 3]);
                 let around = &corners[start[a as usize] as usize..start[a as usize + 1] as usize];
-                // Rank of `ti` among holders of (a, b); corners around a are
-                // listed in increasing triangle order.
-                let rank = around
-                    .iter()
-                    .filter(|c| c.next == b && c.triangle < ti as u32)
-                    .count();
-                if let Some(c) = around.iter().filter(|c| c.prev == b).nth(rank) {
-                    neighbours[ti][slot] = c.triangle;
-                    // In that triangle (b, a) is the slot that ends at a.
-                    neighbours[c.triangle as usize][(c.k as usize + 2) % 3] = ti as u32;
+                // One pass: the rank of `ti` among holders of (a, b) (corners
+                // around a are in increasing triangle order), and the first
+                // holders of (b, a). Valence above 16 falls back to a rescan.
+                let mut rank = 0;
+                let mut opposite = [(0u32, 0u32); 16];
+                let mut opposite_count = 0;
+                for c in around {
+                    if c.next == b && c.triangle < ti as u32 {
+                        rank += 1;
+                    } else if c.prev == b {
+                        if opposite_count < opposite.len() {
+                            opposite[opposite_count] = (c.triangle, c.k);
+                        }
+                        opposite_count += 1;
+                    }
                 }
+                if rank >= opposite_count {
+                    continue;
+                }
+                let (u, k) = if rank < opposite.len() {
+                    opposite[rank]
+                } else {
+                    around
+                        .iter()
+                        .filter(|c| c.prev == b)
+                        .nth(rank)
+                        .map(|c| (c.triangle, c.k))
+                        .expect("rank is below the holder count")
+                };
+                neighbours[ti][slot] = u;
+                // In that triangle (b, a) is the slot that ends at a.
+                neighbours[u as usize][(k as usize + 2) % 3] = ti as u32;
             }
         }
         let adjacency = TriangleAdjacency { neighbours };

@@ -297,7 +297,7 @@ pub(super) fn strip_patches(
     let mut seeds: Vec<u32> = (0..quad_count as u32)
         .filter(|&s| bound(s) >= min_patch_quads)
         .collect();
-    seeds.sort_by_key(|&s| std::cmp::Reverse(bound(s)));
+    seeds.sort_unstable_by_key(|&s| (std::cmp::Reverse(bound(s)), s));
     for seed in seeds {
         let [l0, l1] = lengths[seed as usize];
         // The rows of a patch cross the perpendicular row through the seed,
