@@ -89,8 +89,19 @@ impl Default for StripifyOptions {
 /// over the triangles; adjacency built without sorting).
 #[must_use]
 pub fn stripify(mesh: &Mesh, options: &StripifyOptions) -> Strips {
-    let adjacency = TriangleAdjacency::new(mesh);
-    stripify_with_adjacency(mesh, &adjacency, options)
+    if options.patches && mesh.triangle_count() >= PARALLEL_MIN_TRIANGLES {
+        // The patch pass's longest-edge test needs only positions: compute
+        // it on the second core while the adjacency is built.
+        let (adjacency, longest) = std::thread::scope(|scope| {
+            let handle = scope.spawn(|| patches::longest_edges(&mesh.triangles, &mesh.positions));
+            let adjacency = TriangleAdjacency::new(mesh);
+            (adjacency, handle.join().expect("stripify worker panicked"))
+        });
+        stripify_impl(mesh, &adjacency, Some(longest), options)
+    } else {
+        let adjacency = TriangleAdjacency::new(mesh);
+        stripify_impl(mesh, &adjacency, None, options)
+    }
 }
 
 /// [`stripify`] with an adjacency the caller already has.
@@ -98,6 +109,15 @@ pub fn stripify(mesh: &Mesh, options: &StripifyOptions) -> Strips {
 pub fn stripify_with_adjacency(
     mesh: &Mesh,
     adjacency: &TriangleAdjacency,
+    options: &StripifyOptions,
+) -> Strips {
+    stripify_impl(mesh, adjacency, None, options)
+}
+
+fn stripify_impl(
+    mesh: &Mesh,
+    adjacency: &TriangleAdjacency,
+    longest: Option<Vec<u8>>,
     options: &StripifyOptions,
 ) -> Strips {
     let fresh = Walk::new(&mesh.triangles, &adjacency.neighbours);
@@ -146,14 +166,11 @@ pub fn stripify_with_adjacency(
         if !options.patches {
             return None;
         }
+        let longest =
+            longest.unwrap_or_else(|| patches::longest_edges(&mesh.triangles, &mesh.positions));
         let mut walk = fresh.clone();
         let mut paths = Vec::new();
-        patches::strip_patches(
-            &mut walk,
-            &mesh.positions,
-            options.min_patch_quads,
-            &mut paths,
-        );
+        patches::strip_patches(&mut walk, &longest, options.min_patch_quads, &mut paths);
         (!paths.is_empty()).then(|| attempt(&walk, &paths, penalties[0]))
     };
     // The two are independent: on two threads when the mesh is large enough

@@ -212,19 +212,32 @@ fn link_quads(
 /// Pairs each triangle with the neighbour across its longest edge when that
 /// edge is the neighbour's longest too. Returns the quads and each
 /// triangle's quad (or `NO_QUAD`).
-fn pair_quads(walk: &Walk<'_>, positions: &[Vec3]) -> (Vec<Quad>, Vec<u32>, Vec<[u8; 3]>) {
-    let tris = walk.tris;
-    let longest: Vec<usize> = tris
-        .iter()
+/// The slot of each triangle's longest edge (the lowest slot on a tie).
+///
+/// Cost: O(T); needs only positions, so it can run while the adjacency is
+/// built.
+pub(super) fn longest_edges(tris: &[[u32; 3]], positions: &[Vec3]) -> Vec<u8> {
+    tris.iter()
         .map(|t| {
-            let len = |s: usize| {
-                positions[t[s] as usize].distance_squared(positions[t[(s + 1) % 3] as usize])
-            };
-            (0..3)
-                .max_by(|&a, &b| len(a).total_cmp(&len(b)))
-                .unwrap_or(0)
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            let l = [
+                a.distance_squared(b),
+                b.distance_squared(c),
+                c.distance_squared(a),
+            ];
+            if l[0] >= l[1] && l[0] >= l[2] {
+                0
+            } else if l[1] >= l[2] {
+                1
+            } else {
+                2
+            }
         })
-        .collect();
+        .collect()
+}
+
+fn pair_quads(walk: &Walk<'_>, longest: &[u8]) -> (Vec<Quad>, Vec<u32>, Vec<[u8; 3]>) {
+    let tris = walk.tris;
     let mut quads = Vec::new();
     let mut quad_of = vec![NO_QUAD; tris.len()];
     // Outer edge index of each triangle slot in its quad (the diagonal's
@@ -234,12 +247,12 @@ fn pair_quads(walk: &Walk<'_>, positions: &[Vec3]) -> (Vec<Quad>, Vec<u32>, Vec<
         if quad_of[t as usize] != NO_QUAD || !walk.is_free(t) {
             continue;
         }
-        let s = longest[t as usize];
+        let s = longest[t as usize] as usize;
         let u = walk.adj[t as usize][s];
         if !walk.is_free(u) || quad_of[u as usize] != NO_QUAD {
             continue;
         }
-        let su = longest[u as usize];
+        let su = longest[u as usize] as usize;
         if walk.adj[u as usize][su] != t {
             continue;
         }
@@ -268,11 +281,11 @@ fn pair_quads(walk: &Walk<'_>, positions: &[Vec3]) -> (Vec<Quad>, Vec<u32>, Vec<
 /// quad-grid meshes where patches are accepted.
 pub(super) fn strip_patches(
     walk: &mut Walk<'_>,
-    positions: &[Vec3],
+    longest: &[u8],
     min_patch_quads: usize,
     paths: &mut Vec<Vec<u32>>,
 ) {
-    let (quads, quad_of, edge_of) = pair_quads(walk, positions);
+    let (quads, quad_of, edge_of) = pair_quads(walk, longest);
     let quad_count = quads.len();
     let first_row = paths.len();
     let links = link_quads(walk, &quads, &quad_of, &edge_of);
