@@ -159,9 +159,15 @@ impl Quads<'_, '_> {
     }
 
     /// The largest rectangle of rows through `(q, entry)`.
-    fn patch(&mut self, q: u32, entry: usize) -> Vec<Vec<Step>> {
+    /// `rows_bound` bounds the number of rows (the length of the
+    /// perpendicular row through `q`); when the middle row is too short for
+    /// `min_area` even with that many rows, no row is stacked.
+    fn patch(&mut self, q: u32, entry: usize, rows_bound: u32, min_area: usize) -> Vec<Vec<Step>> {
         self.current += 1;
         let mut rows = vec![self.row(q, entry)];
+        if rows[0].len() * (rows_bound as usize) < min_area {
+            return rows;
+        }
         for side in [1, 3] {
             let mut last = 0;
             while let Some(next) = self.next_row(&rows[last], side) {
@@ -321,8 +327,8 @@ pub(super) fn strip_patches(
         {
             continue;
         }
-        let a = q.patch(seed, 0);
-        let b = q.patch(seed, 1);
+        let a = q.patch(seed, 0, l1, min_patch_quads);
+        let b = q.patch(seed, 1, l0, min_patch_quads);
         let area = |rows: &Vec<Vec<Step>>| rows.len() * rows[0].len();
         if area(&a).max(area(&b)) < min_patch_quads {
             for &(quad, _) in a.iter().chain(&b).flatten() {
