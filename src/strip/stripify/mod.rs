@@ -133,9 +133,7 @@ fn stripify_impl(
 
     // One run of the local pass from `walk` (with `done` paths already
     // made), joined and encoded: (indices, run starts).
-    let attempt = |walk: &Walk<'_>, done: &[Vec<u32>], penalty: f32| -> Encoded {
-        let mut paths = done.to_vec();
-        let mut w = walk.clone();
+    let attempt = |mut w: Walk<'_>, mut paths: Vec<Vec<u32>>, penalty: f32| -> Encoded {
         w.swap_penalty = penalty;
         greedy::strip_rest(&mut w, &mut paths);
         if options.join_ends {
@@ -154,7 +152,7 @@ fn stripify_impl(
     let from_fresh = || {
         penalties
             .iter()
-            .map(|&p| attempt(&fresh, &[], p))
+            .map(|&p| attempt(fresh.clone(), Vec::new(), p))
             .min_by_key(Encoded::cost)
             .expect("at least one penalty")
     };
@@ -171,7 +169,7 @@ fn stripify_impl(
         let mut walk = fresh.clone();
         let mut paths = Vec::new();
         patches::strip_patches(&mut walk, &longest, options.min_patch_quads, &mut paths);
-        (!paths.is_empty()).then(|| attempt(&walk, &paths, penalties[0]))
+        (!paths.is_empty()).then(|| attempt(walk, paths, penalties[0]))
     };
     // The two are independent: on two threads when the mesh is large enough
     // to pay for the spawn.
