@@ -20,11 +20,16 @@ pub const NO_NEIGHBOUR: u32 = u32::MAX;
 ///
 /// Edge slot `i` of triangle `[v0, v1, v2]` is the directed edge
 /// `(v[i], v[(i + 1) % 3])`. Invariant: if `neighbours[t][i] == u` then
-/// `u` holds the reversed edge in some slot `j` and `neighbours[u][j] == t`.
+/// `u` holds the reversed edge in slot `j = mates[t][i]` and
+/// `neighbours[u][j] == t`. Two triangles can be neighbours across more than
+/// one edge, so the slot on the other side is recorded, not searched for.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TriangleAdjacency {
     /// Neighbour across each edge slot, or [`NO_NEIGHBOUR`].
     pub neighbours: Vec<[u32; 3]>,
+    /// For each edge slot with a neighbour, the neighbour's slot holding the
+    /// same edge reversed (unspecified where there is no neighbour).
+    pub mates: Vec<[u8; 3]>,
 }
 
 impl TriangleAdjacency {
@@ -73,6 +78,7 @@ impl TriangleAdjacency {
         }
 
         let mut neighbours = vec![[NO_NEIGHBOUR; 3]; tris.len()];
+        let mut mates = vec![[0u8; 3]; tris.len()];
         for (ti, t) in tris.iter().enumerate() {
             for slot in 0..3 {
                 if neighbours[ti][slot] != NO_NEIGHBOUR {
@@ -109,21 +115,36 @@ impl TriangleAdjacency {
                         .map(|c| (c.triangle, c.k))
                         .expect("rank is below the holder count")
                 };
-                neighbours[ti][slot] = u;
                 // In that triangle (b, a) is the slot that ends at a.
-                neighbours[u as usize][(k as usize + 2) % 3] = ti as u32;
+                let j = (k as usize + 2) % 3;
+                neighbours[ti][slot] = u;
+                mates[ti][slot] = j as u8;
+                neighbours[u as usize][j] = ti as u32;
+                mates[u as usize][j] = slot as u8;
             }
         }
-        let adjacency = TriangleAdjacency { neighbours };
+        let adjacency = TriangleAdjacency { neighbours, mates };
         #[cfg(debug_assertions)]
         adjacency.validate(mesh);
         adjacency
     }
 
-    /// The edge slot of `t` whose neighbour is `u`, if any.
+    /// The first edge slot of `t` whose neighbour is `u`, if any. When the
+    /// two share more than one edge, prefer [`TriangleAdjacency::mate`] from
+    /// a known slot.
     #[must_use]
     pub fn slot_of(&self, t: u32, u: u32) -> Option<usize> {
         self.neighbours[t as usize].iter().position(|&n| n == u)
+    }
+
+    /// The slot of `t`'s neighbour across `slot` that holds the same edge.
+    ///
+    /// # Panics
+    /// In debug builds, if `t` has no neighbour across `slot`.
+    #[must_use]
+    pub fn mate(&self, t: u32, slot: usize) -> usize {
+        debug_assert_ne!(self.neighbours[t as usize][slot], NO_NEIGHBOUR);
+        self.mates[t as usize][slot] as usize
     }
 
     /// Asserts the symmetry invariant documented on the type.
@@ -140,9 +161,11 @@ impl TriangleAdjacency {
                 let tri = mesh.triangles[t];
                 let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
                 let tu = mesh.triangles[u as usize];
-                let j = (0..3)
-                    .find(|&j| tu[j] == b && tu[(j + 1) % 3] == a)
-                    .expect("neighbour does not hold the reversed edge");
+                let j = self.mate(t as u32, slot);
+                assert!(
+                    tu[j] == b && tu[(j + 1) % 3] == a,
+                    "the mate slot does not hold the reversed edge"
+                );
                 assert_eq!(
                     self.neighbours[u as usize][j], t as u32,
                     "adjacency not symmetric"
@@ -179,6 +202,18 @@ mod tests {
                 [0, NO_NEIGHBOUR, NO_NEIGHBOUR]
             ]
         );
+        // Edge (2, 0) is slot 2 of triangle 0 and slot 0 of triangle 1.
+        assert_eq!((adj.mate(0, 2), adj.mate(1, 0)), (0, 2));
+    }
+
+    /// A double-sided pair: both triangles share all three edges, so the
+    /// neighbour alone does not say which edge a walk crossed.
+    #[test]
+    fn double_sided_pair_records_each_edge_mate() {
+        let adj = TriangleAdjacency::new(&mesh(vec![[0, 1, 2], [0, 2, 1]]));
+        assert_eq!(adj.neighbours, vec![[1, 1, 1], [0, 0, 0]]);
+        assert_eq!(adj.mates, vec![[2, 1, 0], [2, 1, 0]]);
+        assert_eq!(adj.slot_of(0, 1), Some(0));
     }
 
     #[test]

@@ -112,7 +112,7 @@ pub fn clean(
     let mut triangles = Vec::with_capacity(raw.triangles.len());
     for tri in &raw.triangles {
         let t = tri.map(|v| weld_map[v as usize]);
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+        if super::is_degenerate(t) {
             report.degenerate_dropped += 1;
         } else {
             triangles.push(t);

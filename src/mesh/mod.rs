@@ -17,6 +17,14 @@ pub use clean::{clean, CleanOptions, CleanReport, RawMesh};
 use crate::error::{Error, Result};
 use glam::Vec3;
 
+/// Whether a triangle repeats a vertex index (draws nothing). The one test
+/// used by loaders, cleaning, validation and strip decoding.
+#[must_use]
+#[inline]
+pub fn is_degenerate(t: [u32; 3]) -> bool {
+    t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
+}
+
 /// An indexed triangle mesh.
 ///
 /// Invariants (checked by [`Mesh::validate`]): every index is below
@@ -90,7 +98,7 @@ impl Mesh {
                 }
                 referenced[v] = true;
             }
-            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+            if is_degenerate(*tri) {
                 return Err(bad(format!("triangle {t} is degenerate: {tri:?}")));
             }
         }

@@ -14,6 +14,7 @@ pub mod stripify;
 pub use stripify::{stripify, stripify_with_adjacency, StripifyOptions};
 
 use crate::error::{Error, Result};
+use crate::mesh::is_degenerate;
 
 /// Generalized triangle strips over a mesh's vertices.
 ///
@@ -189,17 +190,16 @@ impl Strips {
 /// skipped.
 pub fn decode_run(run: &[u32], out: &mut Vec<[u32; 3]>) {
     for (i, w) in run.windows(3).enumerate() {
-        let (a, b, c) = (w[0], w[1], w[2]);
-        if a == b || b == c || a == c {
-            continue;
+        let [a, b, c] = [w[0], w[1], w[2]];
+        if !is_degenerate([a, b, c]) {
+            out.push(if i % 2 == 0 { [a, b, c] } else { [b, a, c] });
         }
-        out.push(if i % 2 == 0 { [a, b, c] } else { [b, a, c] });
     }
 }
 
 fn run_triangle_count(run: &[u32]) -> usize {
     run.windows(3)
-        .filter(|w| w[0] != w[1] && w[1] != w[2] && w[0] != w[2])
+        .filter(|w| !is_degenerate([w[0], w[1], w[2]]))
         .count()
 }
 

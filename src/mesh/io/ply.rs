@@ -474,6 +474,7 @@ fn read_element(
     }
 
     let mut list: Vec<i64> = Vec::new();
+    let mut run: Vec<u32> = Vec::new();
     for index in 0..element.count {
         let mut coords = [0.0f64; 3];
         for (property, &role) in element.properties.iter().zip(&roles) {
@@ -540,7 +541,7 @@ fn read_element(
                 });
             }
             if is_strip {
-                push_strip(&list, raw);
+                push_strip(&list, &mut run, raw);
             } else {
                 push_polygon(&list, raw);
             }
@@ -562,20 +563,17 @@ fn push_polygon(corners: &[i64], raw: &mut RawMesh) {
     }
 }
 
-/// Decodes one `tristrips` list: runs split at `-1`, triangle `i` of a run is
-/// `(s[i], s[i+1], s[i+2])` with odd `i` flipped; triangles with a repeated
-/// index (the strip's swaps) are dropped and counted.
-fn push_strip(list: &[i64], raw: &mut RawMesh) {
-    for run in list.split(|&i| i == -1) {
-        for (i, w) in run.windows(3).enumerate() {
-            let [a, b, c] = [w[0] as u32, w[1] as u32, w[2] as u32];
-            if a == b || b == c || a == c {
-                raw.degenerate_in_source += 1;
-            } else if i % 2 == 0 {
-                raw.triangles.push([a, b, c]);
-            } else {
-                raw.triangles.push([b, a, c]);
-            }
-        }
+/// Decodes one `tristrips` list: runs split at `-1`, each decoded by the
+/// crate's one strip rule ([`crate::strip::decode_run`]); windows with a
+/// repeated index (the strip's swaps) are dropped and counted. Indices were
+/// range-checked by the caller.
+fn push_strip(list: &[i64], run: &mut Vec<u32>, raw: &mut RawMesh) {
+    for part in list.split(|&i| i == -1) {
+        run.clear();
+        run.extend(part.iter().map(|&i| i as u32));
+        let before = raw.triangles.len();
+        crate::strip::decode_run(run, &mut raw.triangles);
+        let windows = run.len().saturating_sub(2);
+        raw.degenerate_in_source += windows - (raw.triangles.len() - before);
     }
 }

@@ -8,7 +8,7 @@
 //! the other direction.
 
 use super::path::{pivot, slot_to};
-use crate::mesh::NO_NEIGHBOUR;
+use crate::mesh::{TriangleAdjacency, NO_NEIGHBOUR};
 
 /// Which triangles are taken, and a bucket queue of the free ones by their
 /// number of free neighbours (0–3). Entries are lazy: a triangle is pushed
@@ -17,7 +17,7 @@ use crate::mesh::NO_NEIGHBOUR;
 #[derive(Clone)]
 pub(super) struct Walk<'a> {
     pub(super) tris: &'a [[u32; 3]],
-    pub(super) adj: &'a [[u32; 3]],
+    pub(super) adj: &'a TriangleAdjacency,
     pub(super) used: Vec<bool>,
     free_deg: Vec<u8>,
     buckets: [Vec<u32>; 4],
@@ -25,8 +25,9 @@ pub(super) struct Walk<'a> {
 }
 
 impl<'a> Walk<'a> {
-    pub(super) fn new(tris: &'a [[u32; 3]], adj: &'a [[u32; 3]]) -> Walk<'a> {
+    pub(super) fn new(tris: &'a [[u32; 3]], adj: &'a TriangleAdjacency) -> Walk<'a> {
         let free_deg: Vec<u8> = adj
+            .neighbours
             .iter()
             .map(|ns| ns.iter().filter(|&&n| n != NO_NEIGHBOUR).count() as u8)
             .collect();
@@ -53,7 +54,7 @@ impl<'a> Walk<'a> {
     pub(super) fn take(&mut self, t: u32) {
         debug_assert!(!self.used[t as usize], "triangle taken twice");
         self.used[t as usize] = true;
-        for &n in &self.adj[t as usize] {
+        for &n in &self.adj.neighbours[t as usize] {
             if self.is_free(n) {
                 let d = &mut self.free_deg[n as usize];
                 *d -= 1;
@@ -94,7 +95,7 @@ impl<'a> Walk<'a> {
         });
         loop {
             let t = &self.tris[cur as usize];
-            let ns = &self.adj[cur as usize];
+            let ns = &self.adj.neighbours[cur as usize];
             let mut best: Option<(f32, usize)> = None;
             for (s, &cand) in ns.iter().enumerate() {
                 if Some(s) == entry || !self.is_free(cand) {
@@ -113,11 +114,7 @@ impl<'a> Walk<'a> {
             let Some((_, s)) = best else { return };
             let next = ns[s];
             last_pivot = entry.map(|e| pivot(t, e, s));
-            // The slot of `next` that holds this edge reversed.
-            let b = t[(s + 1) % 3];
-            let nt = &self.tris[next as usize];
-            entry = (0..3).find(|&j| self.adj[next as usize][j] == cur && nt[j] == b);
-            debug_assert!(entry.is_some(), "adjacency is not symmetric");
+            entry = Some(self.adj.mate(cur, s));
             self.take(next);
             path.push(next);
             cur = next;

@@ -37,9 +37,10 @@ struct Encoded {
 }
 
 impl Encoded {
-    /// Indices sent with restart encoding (one restart per run boundary).
+    /// Indices sent with restart encoding: the runs plus one restart value
+    /// between consecutive runs (`starts` has one entry more than runs).
     fn cost(&self) -> usize {
-        self.indices.len() + self.starts.len()
+        self.indices.len() + self.starts.len().saturating_sub(2)
     }
 }
 
@@ -57,15 +58,21 @@ pub struct StripifyOptions {
     /// picks the next triangle: score = free neighbours of the candidate +
     /// the penalty if it needs a swap; lowest wins. The local pass runs once
     /// per penalty from the untouched mesh, and with the first penalty after
-    /// the global pass; the run with fewest indices is kept. Below 1 means "fewest free neighbours first, swap as
-    /// tie-break" (the rule of the STRIPE paper; best on 16 of the 20 shared
+    /// the global pass; the run with fewest indices is kept. Below 1 means
+    /// "fewest free neighbours first, swap as tie-break" (the rule of the STRIPE paper; best on 16 of the 20 shared
     /// models); above 1 avoids swaps unless the other side is two
     /// neighbours freer (best on `non_manif_hole.ply`: 1.221 against 1.314
     /// indices per triangle). Empty means `[0.5]`. Meshes of 20K triangles
     /// or more use only the first penalty (see
     /// `EXTRA_PENALTIES_MAX_TRIANGLES`).
     pub swap_penalties: [Option<f32>; 2],
-    /// Join strips whose end triangles are neighbours after both passes.
+    /// Join strips whose end triangles are neighbours, after the patch
+    /// start. After a local pass from the untouched mesh there is nothing to
+    /// join: a strip ends only when its end triangle has no free neighbour,
+    /// so any neighbour is in a strip finished earlier, whose own end had
+    /// no free neighbour then either (measured: 0 joins on all 23 meshes).
+    /// Patch rows are taken before they grow, so their ends can meet
+    /// (bunny: 13 joins, icosphere 100K: 29).
     pub join_ends: bool,
 }
 
@@ -120,7 +127,7 @@ fn stripify_impl(
     longest: Option<Vec<u8>>,
     options: &StripifyOptions,
 ) -> Strips {
-    let fresh = Walk::new(&mesh.triangles, &adjacency.neighbours);
+    let fresh = Walk::new(&mesh.triangles, adjacency);
     let penalties: Vec<f32> = options.swap_penalties.iter().flatten().copied().collect();
     let mut penalties = if penalties.is_empty() {
         vec![0.5]
@@ -131,33 +138,34 @@ fn stripify_impl(
         penalties.truncate(1);
     }
 
-    // One run of the local pass from `walk` (with `done` paths already
-    // made), joined and encoded: (indices, run starts).
-    let attempt = |mut w: Walk<'_>, mut paths: Vec<Vec<u32>>, penalty: f32| -> Encoded {
-        w.swap_penalty = penalty;
-        greedy::strip_rest(&mut w, &mut paths);
-        if options.join_ends {
-            path::join_ends(&mut paths, &adjacency.neighbours);
-        }
-        let mut indices = Vec::with_capacity(mesh.triangle_count() * 6 / 5 + 3 * paths.len());
-        let mut starts = Vec::with_capacity(paths.len() + 1);
-        starts.push(0);
-        for p in &paths {
-            path::encode(p, &mesh.triangles, &adjacency.neighbours, &mut indices);
-            starts.push(indices.len() as u32);
-        }
-        Encoded { indices, starts }
-    };
+    // One run of the local pass from `w` (with `paths` already made), then
+    // `join`ed if asked, and encoded.
+    let attempt =
+        |mut w: Walk<'_>, mut paths: Vec<Vec<u32>>, penalty: f32, join: bool| -> Encoded {
+            w.swap_penalty = penalty;
+            greedy::strip_rest(&mut w, &mut paths);
+            if join {
+                path::join_ends(&mut paths, adjacency);
+            }
+            let mut indices = Vec::with_capacity(mesh.triangle_count() * 6 / 5 + 3 * paths.len());
+            let mut starts = Vec::with_capacity(paths.len() + 1);
+            starts.push(0);
+            for p in &paths {
+                path::encode(p, &mesh.triangles, adjacency, &mut indices);
+                starts.push(indices.len() as u32);
+            }
+            Encoded { indices, starts }
+        };
     // From the untouched mesh, with every penalty.
     let from_fresh = || {
         penalties
             .iter()
-            .map(|&p| attempt(fresh.clone(), Vec::new(), p))
+            .map(|&p| attempt(fresh.clone(), Vec::new(), p, false))
             .min_by_key(Encoded::cost)
             .expect("at least one penalty")
     };
     // After the global pass, with the first penalty. Patches win on some
-    // scans (bunny: 1.199 against 1.204 indices per triangle) and lose on
+    // scans (bunny: 1.193 against 1.204 indices per triangle) and lose on
     // meshes the local pass walks in one strip (icosphere: 1.031 against
     // 1.008), so both starts are tried and the cheaper result is kept.
     let from_patches = || {
@@ -169,7 +177,7 @@ fn stripify_impl(
         let mut walk = fresh.clone();
         let mut paths = Vec::new();
         patches::strip_patches(&mut walk, &longest, options.min_patch_quads, &mut paths);
-        (!paths.is_empty()).then(|| attempt(walk, paths, penalties[0]))
+        (!paths.is_empty()).then(|| attempt(walk, paths, penalties[0], options.join_ends))
     };
     // The two are independent: on two threads when the mesh is large enough
     // to pay for the spawn.

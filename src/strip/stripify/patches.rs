@@ -190,34 +190,21 @@ fn link_quads(
         .iter()
         .enumerate()
         .map(|(qi, quad)| {
-            let mut links = [(NO_QUAD, 0u8); 4];
-            for (link, &(t, s)) in links.iter_mut().zip(&quad.edges) {
-                let n = walk.adj[t as usize][s];
+            quad.edges.map(|(t, s)| {
+                let n = walk.adj.neighbours[t as usize][s];
                 if n == NO_NEIGHBOUR {
-                    continue;
+                    return (NO_QUAD, 0);
                 }
                 let qn = quad_of[n as usize];
                 if qn == NO_QUAD || qn == qi as u32 {
-                    continue;
+                    return (NO_QUAD, 0);
                 }
-                // The slot of `n` holding this very edge reversed (two
-                // triangles can be neighbours across more than one edge).
-                let b = walk.tris[t as usize][(s + 1) % 3];
-                let ns = &walk.adj[n as usize];
-                let nt = &walk.tris[n as usize];
-                let j = (0..3)
-                    .find(|&j| ns[j] == t && nt[j] == b)
-                    .expect("adjacency is not symmetric (internal error)");
-                *link = (qn, edge_of[n as usize][j]);
-            }
-            links
+                (qn, edge_of[n as usize][walk.adj.mate(t, s)])
+            })
         })
         .collect()
 }
 
-/// Pairs each triangle with the neighbour across its longest edge when that
-/// edge is the neighbour's longest too. Returns the quads and each
-/// triangle's quad (or `NO_QUAD`).
 /// The slot of each triangle's longest edge (the lowest slot on a tie).
 ///
 /// Cost: O(T); needs only positions, so it can run while the adjacency is
@@ -254,12 +241,12 @@ fn pair_quads(walk: &Walk<'_>, longest: &[u8]) -> (Vec<Quad>, Vec<u32>, Vec<[u8;
             continue;
         }
         let s = longest[t as usize] as usize;
-        let u = walk.adj[t as usize][s];
+        let u = walk.adj.neighbours[t as usize][s];
         if !walk.is_free(u) || quad_of[u as usize] != NO_QUAD {
             continue;
         }
         let su = longest[u as usize] as usize;
-        if walk.adj[u as usize][su] != t {
+        if walk.adj.neighbours[u as usize][su] != t {
             continue;
         }
         quad_of[t as usize] = quads.len() as u32;

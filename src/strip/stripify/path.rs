@@ -15,7 +15,7 @@
 //! a consistently oriented neighbour is always its own winding, with or
 //! without a swap before it.
 
-use crate::mesh::NO_NEIGHBOUR;
+use crate::mesh::{TriangleAdjacency, NO_NEIGHBOUR};
 
 /// The vertex shared by edge slots `a` and `b` (distinct) of triangle `t`.
 pub(super) fn pivot(t: &[u32; 3], a: usize, b: usize) -> u32 {
@@ -27,16 +27,15 @@ pub(super) fn pivot(t: &[u32; 3], a: usize, b: usize) -> u32 {
     }
 }
 
-/// Slot of `t` whose neighbour is `u`.
-pub(super) fn slot_to(adj: &[[u32; 3]], t: u32, u: u32) -> usize {
-    adj[t as usize]
-        .iter()
-        .position(|&n| n == u)
+/// A slot of `t` whose neighbour is `u` (the first when they share more
+/// than one edge: any shared edge gives a valid run).
+pub(super) fn slot_to(adj: &TriangleAdjacency, t: u32, u: u32) -> usize {
+    adj.slot_of(t, u)
         .expect("path triangles are not adjacent (internal error)")
 }
 
 /// Whether starting the run at `path[0]` costs a swap at `path[1]`.
-fn start_swap(path: &[u32], tris: &[[u32; 3]], adj: &[[u32; 3]]) -> bool {
+fn start_swap(path: &[u32], tris: &[[u32; 3]], adj: &TriangleAdjacency) -> bool {
     if path.len() < 3 {
         return false;
     }
@@ -52,7 +51,7 @@ fn start_swap(path: &[u32], tris: &[[u32; 3]], adj: &[[u32; 3]]) -> bool {
 /// fewer swaps (the front on a tie).
 ///
 /// Cost: O(path length).
-pub(super) fn encode(path: &[u32], tris: &[[u32; 3]], adj: &[[u32; 3]], out: &mut Vec<u32>) {
+pub(super) fn encode(path: &[u32], tris: &[[u32; 3]], adj: &TriangleAdjacency, out: &mut Vec<u32>) {
     let reversed: Vec<u32>;
     let path = if start_swap(path, tris, adj) && !start_swap_reversed(path, tris, adj) {
         reversed = path.iter().rev().copied().collect();
@@ -85,7 +84,7 @@ pub(super) fn encode(path: &[u32], tris: &[[u32; 3]], adj: &[[u32; 3]], out: &mu
     }
 }
 
-fn start_swap_reversed(path: &[u32], tris: &[[u32; 3]], adj: &[[u32; 3]]) -> bool {
+fn start_swap_reversed(path: &[u32], tris: &[[u32; 3]], adj: &TriangleAdjacency) -> bool {
     let n = path.len();
     if n < 3 {
         return false;
@@ -102,7 +101,7 @@ fn start_swap_reversed(path: &[u32], tris: &[[u32; 3]], adj: &[[u32; 3]]) -> boo
 /// run for at most one swap. One pass over the path ends.
 ///
 /// Cost: O(paths + T) time.
-pub(super) fn join_ends(paths: &mut Vec<Vec<u32>>, adj: &[[u32; 3]]) {
+pub(super) fn join_ends(paths: &mut Vec<Vec<u32>>, adj: &TriangleAdjacency) {
     // For every triangle that ends a path: (path id, is_front).
     let mut end_of = std::collections::HashMap::with_capacity(2 * paths.len());
     for (i, p) in paths.iter().enumerate() {
@@ -118,7 +117,7 @@ pub(super) fn join_ends(paths: &mut Vec<Vec<u32>>, adj: &[[u32; 3]]) {
         loop {
             let back = *paths[i].last().expect("paths are not empty");
             let mut joined = false;
-            for &n in &adj[back as usize] {
+            for &n in &adj.neighbours[back as usize] {
                 if n == NO_NEIGHBOUR {
                     continue;
                 }
