@@ -22,11 +22,14 @@
 //! # Ok::<(), mts::Error>(())
 //! ```
 
+pub mod distance;
 pub mod error;
 pub mod mesh;
 pub mod peers;
+pub mod simplify;
 pub mod strip;
 
 pub use error::{Error, Place, Result};
 pub use mesh::Mesh;
+pub use simplify::{simplify, Collapses, SimplifyOptions};
 pub use strip::{stripify, StripifyOptions, Strips};

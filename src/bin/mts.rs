@@ -26,6 +26,13 @@ struct Cli {
 enum Command {
     /// Cut a mesh into triangle strips and compare with meshoptimizer's.
     Strips(StripsArgs),
+    /// Record the quadric-error contraction sequence, take one LoD of it and
+    /// measure its error beside meshoptimizer's simplify.
+    Simplify(SimplifyArgs),
+    /// Hausdorff and RMS distance of a mesh to a reference mesh.
+    Distance(DistanceArgs),
+    /// Write a mesh (a file or a generated one) as OBJ.
+    Convert(ConvertArgs),
 }
 
 /// Where a mesh comes from: a file or a built-in generator.
@@ -86,6 +93,64 @@ struct StripsArgs {
     /// Do not join strips whose ends are neighbours.
     #[arg(long)]
     no_join: bool,
+}
+
+#[derive(Args)]
+#[command(group(clap::ArgGroup::new("target").required(true).args(["ratio", "triangles"])))]
+struct SimplifyArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// Keep this share of the triangles (0..1).
+    #[arg(long)]
+    ratio: Option<f64>,
+    /// Keep at most this many triangles.
+    #[arg(long)]
+    triangles: Option<usize>,
+    /// Write the simplified mesh as OBJ.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Place each surviving vertex at the quadric's optimum (new vertices)
+    /// instead of keeping an endpoint.
+    #[arg(long)]
+    optimal: bool,
+    /// Also contract vertex pairs closer than this share of the diagonal.
+    #[arg(long, value_name = "SHARE")]
+    pair_distance: Option<f32>,
+    /// Weight of the boundary-preserving planes.
+    #[arg(long)]
+    boundary_weight: Option<f64>,
+    /// Surface samples per side for the error measurement.
+    #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES)]
+    samples: usize,
+    /// Skip meshoptimizer.
+    #[arg(long)]
+    no_meshopt: bool,
+}
+
+#[derive(Args)]
+struct DistanceArgs {
+    /// The reference mesh (errors are relative to its bounding-box diagonal).
+    reference: PathBuf,
+    /// The mesh measured against it.
+    other: PathBuf,
+    /// Surface samples per side.
+    #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES)]
+    samples: usize,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct ConvertArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// The OBJ file to write.
+    #[arg(short, long)]
+    output: PathBuf,
 }
 
 fn median_ms<T>(repeat: usize, mut f: impl FnMut() -> T) -> (T, f64) {
@@ -187,9 +252,169 @@ fn strips(args: &StripsArgs) -> Result<()> {
     Ok(())
 }
 
+fn simplify(args: &SimplifyArgs) -> Result<()> {
+    use mts::distance::{surface_distance, Surface};
+    use mts::simplify::{Placement, SimplifyOptions};
+    let (name, mesh, _) = args.source.load()?;
+    let input = mesh.triangle_count();
+    let target = match (args.triangles, args.ratio) {
+        (Some(n), _) => n,
+        (None, Some(r)) if (0.0..=1.0).contains(&r) => (r * input as f64).round() as usize,
+        (None, r) => bail!("--ratio must be between 0 and 1, not {r:?}"),
+    };
+    let defaults = SimplifyOptions::default();
+    let mut options = SimplifyOptions {
+        placement: if args.optimal {
+            Placement::Optimal
+        } else {
+            Placement::Endpoint
+        },
+        pair_distance: args.pair_distance,
+        boundary_weight: args.boundary_weight.unwrap_or(defaults.boundary_weight),
+        stop_at_triangles: None,
+    };
+    let t = Instant::now();
+    let whole = mts::simplify(&mesh, &options);
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    options.stop_at_triangles = Some(target);
+    let t = Instant::now();
+    let partial = mts::simplify(&mesh, &options);
+    let ms_to_target = t.elapsed().as_secs_f64() * 1e3;
+    let collapses = &whole.collapses;
+    let mut lod = collapses.lod_for_triangles(target);
+    // The early-stopped run must be a prefix of the whole sequence.
+    if partial.collapses.steps() != &collapses.steps()[..partial.collapses.max_lod()] {
+        bail!("internal error: the sequence stopped at the target differs from the whole one");
+    }
+    // Compare at one triangle count: ours at the target, meshoptimizer
+    // asked for the same; when it stops above it, ours at its count.
+    let mut peer_triangles = None;
+    if !args.no_meshopt {
+        let wanted = collapses.triangle_count(lod);
+        let (theirs, their_ms) = median_ms(1, || peers::meshopt::simplify(&mesh, wanted));
+        if theirs.len() > wanted {
+            lod = collapses.lod_for_triangles(theirs.len());
+        }
+        peer_triangles = Some((theirs, their_ms));
+    }
+    let triangles = collapses.triangles_at(&mesh, lod);
+    let positions: Vec<glam::Vec3> = mesh
+        .positions
+        .iter()
+        .chain(collapses.appended())
+        .copied()
+        .collect();
+    let ours = Surface {
+        positions: &positions,
+        triangles: &triangles,
+    };
+    let d = surface_distance((&mesh).into(), ours, args.samples);
+    let mut peer = serde_json::Value::Null;
+    if let Some((theirs, their_ms)) = peer_triangles {
+        let td = surface_distance(
+            (&mesh).into(),
+            Surface {
+                positions: &mesh.positions,
+                triangles: &theirs,
+            },
+            args.samples,
+        );
+        peer = json!({
+            "triangles": theirs.len(),
+            "ms": their_ms,
+            "hausdorff": td.hausdorff,
+            "rms": td.rms,
+        });
+    }
+    if let Some(path) = &args.output {
+        mts::mesh::io::save_obj(&collapses.mesh_at(&mesh, lod), path)?;
+    }
+    let v = json!({
+        "mesh": name,
+        "input_triangles": input,
+        "target": target,
+        "triangles": triangles.len(),
+        "lod": lod,
+        "max_lod": collapses.max_lod(),
+        "ms": ms,
+        "ms_to_target": ms_to_target,
+        "quadric_error": collapses.error(lod),
+        "hausdorff": d.hausdorff,
+        "rms": d.rms,
+        "stop": whole.stop.to_string(),
+        "meshopt": peer,
+    });
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!(
+        "{name}: {input} triangles -> target {target}; sequence of {} contractions, {}",
+        collapses.max_lod(),
+        whole.stop
+    );
+    println!("{:<26}{:>14}{:>14}", "", "mts", "meshopt");
+    let cell = |x: &serde_json::Value, fmt: &dyn Fn(f64) -> String| {
+        x.as_f64().map_or_else(|| "-".to_string(), fmt)
+    };
+    let int = |x: f64| format!("{x:.0}");
+    let ms2 = |x: f64| format!("{x:.1}");
+    let rel = |x: f64| format!("{x:.6}");
+    let rows: [(&str, &str, &dyn Fn(f64) -> String); 4] = [
+        ("triangles", "triangles", &int),
+        ("ms (to target)", "ms", &ms2),
+        ("Hausdorff / diagonal", "hausdorff", &rel),
+        ("RMS / diagonal", "rms", &rel),
+    ];
+    for (label, key, fmt) in rows {
+        let mine = if key == "ms" {
+            format!("{:.1}", ms_to_target)
+        } else {
+            cell(&v[key], fmt)
+        };
+        println!("{label:<26}{mine:>14}{:>14}", cell(&v["meshopt"][key], fmt));
+    }
+    println!("{:<26}{:>14.1}", "ms (whole sequence)", ms);
+    Ok(())
+}
+
+fn distance(args: &DistanceArgs) -> Result<()> {
+    let options = LoadOptions::default();
+    let (a, _) = load(&args.reference, options).context("cannot load the reference")?;
+    let (b, _) = load(&args.other, options).context("cannot load the measured mesh")?;
+    let d = mts::distance::surface_distance((&a).into(), (&b).into(), args.samples);
+    if args.json {
+        let v = json!({
+            "reference_triangles": a.triangle_count(),
+            "triangles": b.triangle_count(),
+            "hausdorff": d.hausdorff,
+            "rms": d.rms,
+            "forward": d.forward,
+            "backward": d.backward,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "Hausdorff {:.6}  RMS {:.6}  (relative to the reference's diagonal; \
+             reference -> other {:.6}, other -> reference {:.6})",
+            d.hausdorff, d.rms, d.forward, d.backward
+        );
+    }
+    Ok(())
+}
+
+fn convert(args: &ConvertArgs) -> Result<()> {
+    let (_, mesh, _) = args.source.load()?;
+    mts::mesh::io::save_obj(&mesh, &args.output)?;
+    Ok(())
+}
+
 fn run(cli: &Cli) -> Result<()> {
     match &cli.command {
         Command::Strips(args) => strips(args),
+        Command::Simplify(args) => simplify(args),
+        Command::Distance(args) => distance(args),
+        Command::Convert(args) => convert(args),
     }
 }
 

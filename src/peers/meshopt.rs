@@ -32,3 +32,21 @@ pub fn acmr(triangles: &[[u32; 3]], vertex_count: usize) -> f64 {
     let list: Vec<u32> = triangles.iter().flatten().copied().collect();
     f64::from(meshopt::analyze_vertex_cache(&list, vertex_count, CACHE_SIZE, 0, 0).acmr)
 }
+
+/// meshoptimizer's `simplify` toward `target_triangles`, with its default
+/// options and no error limit, as a user would call it: returns its
+/// triangles (indices into `mesh.positions`). It may stop above the target
+/// when its topology rules allow no further collapse.
+#[must_use]
+pub fn simplify(mesh: &Mesh, target_triangles: usize) -> Vec<[u32; 3]> {
+    let positions: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
+    let out = meshopt::simplify_decoder(
+        &mesh.index_list(),
+        &positions,
+        target_triangles * 3,
+        f32::MAX,
+        meshopt::SimplifyOptions::None,
+        None,
+    );
+    out.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+}

@@ -118,3 +118,25 @@ pub fn load(path: &Path, options: LoadOptions) -> Result<(Mesh, CleanReport)> {
     let raw = parse(&bytes, format, path)?;
     clean(raw, options.clean, &path.display().to_string())
 }
+
+/// Writes `mesh` as OBJ text (`v` and `f` lines, 1-based indices, shortest
+/// round-tripping floats) to `path`.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub fn save_obj(mesh: &Mesh, path: &Path) -> Result<()> {
+    use std::io::Write;
+    let io = |source| Error::Io {
+        file: path.to_owned(),
+        source,
+    };
+    let file = std::fs::File::create(path).map_err(io)?;
+    let mut w = std::io::BufWriter::new(file);
+    for p in &mesh.positions {
+        writeln!(w, "v {} {} {}", p.x, p.y, p.z).map_err(io)?;
+    }
+    for t in &mesh.triangles {
+        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}

@@ -1,0 +1,120 @@
+//! Quadric-error pair contractions recorded as one level-of-detail sequence.
+//!
+//! [`simplify`] runs Garland and Heckbert's greedy pair contraction
+//! (`contract.rs`) until no valid pair remains and records every step in
+//! [`Collapses`], which answers representatives, triangle counts and the
+//! naive replay at any LoD. `quadric.rs` holds the error quadrics and
+//! `pairs.rs` the candidate pairs.
+
+mod collapses;
+mod contract;
+mod pairs;
+pub mod quadric;
+
+pub use collapses::{Collapse, Collapses};
+pub use contract::simplify;
+
+/// Where a contraction puts the surviving vertex.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Placement {
+    /// Keep the endpoint with the lower quadric error (the default: the
+    /// model then holds only original vertices, as the MTS model needs).
+    #[default]
+    Endpoint,
+    /// Create a vertex at the quadric's minimiser (or the best of the two
+    /// endpoints and the midpoint when the minimiser is ill-defined); the
+    /// new vertices are appended after the input's.
+    Optimal,
+}
+
+/// Settings of [`simplify`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimplifyOptions {
+    /// Where the surviving vertex goes.
+    pub placement: Placement,
+    /// Also pair vertices that share no edge but lie closer than this
+    /// fraction of the bounding-box diagonal (Garland and Heckbert's
+    /// "virtual pairs", which can join separate parts). Off by default.
+    pub pair_distance: Option<f32>,
+    /// Weight of the planes that hold boundary edges in place, relative to
+    /// the area weight of face planes (a boundary edge of length `l` adds a
+    /// plane of weight `boundary_weight × l²` through it, perpendicular to
+    /// its triangle).
+    pub boundary_weight: f64,
+    /// Stop once the mesh has at most this many triangles (the sequence
+    /// then ends there); `None` runs until no valid pair remains.
+    pub stop_at_triangles: Option<usize>,
+}
+
+impl Default for SimplifyOptions {
+    fn default() -> SimplifyOptions {
+        SimplifyOptions {
+            placement: Placement::Endpoint,
+            pair_distance: None,
+            boundary_weight: 10.0,
+            stop_at_triangles: None,
+        }
+    }
+}
+
+/// Why a contraction sequence ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// [`SimplifyOptions::stop_at_triangles`] was reached.
+    TargetReached,
+    /// Every remaining candidate pair was rejected by a guard (counts in
+    /// [`Stop`]), or no candidate pair was left at all.
+    NoValidPair,
+}
+
+/// Where and why the sequence ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Stop {
+    /// Why it ended.
+    pub reason: StopReason,
+    /// The last LoD (the number of contractions made).
+    pub lod: usize,
+    /// Triangles left at that LoD.
+    pub triangles: usize,
+    /// Vertices still referenced by a triangle at that LoD.
+    pub vertices: usize,
+    /// Candidate pairs examined in the final round, all rejected.
+    pub candidates_left: usize,
+    /// Of those, rejected because a triangle normal would flip.
+    pub rejected_flip: usize,
+    /// Of those, rejected because a non-manifold fin (an edge with extra
+    /// triangles, or two triangles on the same three vertices) would appear.
+    pub rejected_fin: usize,
+}
+
+impl std::fmt::Display for Stop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.reason {
+            StopReason::TargetReached => write!(
+                f,
+                "target reached at LoD {} ({} triangles)",
+                self.lod, self.triangles
+            ),
+            StopReason::NoValidPair => write!(
+                f,
+                "no valid pair left at LoD {} ({} triangles, {} vertices): \
+                 {} candidates, {} would flip a normal, {} would make a fin",
+                self.lod,
+                self.triangles,
+                self.vertices,
+                self.candidates_left,
+                self.rejected_flip,
+                self.rejected_fin
+            ),
+        }
+    }
+}
+
+/// The result of [`simplify`]: the sequence and where it stopped.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Simplification {
+    /// The recorded contraction sequence.
+    pub collapses: Collapses,
+    /// Where and why it ended.
+    pub stop: Stop,
+}
