@@ -354,25 +354,31 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
         whole.stop
     );
     println!("{:<26}{:>14}{:>14}", "", "mts", "meshopt");
-    let cell = |x: &serde_json::Value, fmt: &dyn Fn(f64) -> String| {
-        x.as_f64().map_or_else(|| "-".to_string(), fmt)
+    let peer = &v["meshopt"];
+    let show = |x: &serde_json::Value, digits: usize| {
+        x.as_f64()
+            .map_or_else(|| "-".to_string(), |x| format!("{x:.digits$}"))
     };
-    let int = |x: f64| format!("{x:.0}");
-    let ms2 = |x: f64| format!("{x:.1}");
-    let rel = |x: f64| format!("{x:.6}");
-    let rows: [(&str, &str, &dyn Fn(f64) -> String); 4] = [
-        ("triangles", "triangles", &int),
-        ("ms (to target)", "ms", &ms2),
-        ("Hausdorff / diagonal", "hausdorff", &rel),
-        ("RMS / diagonal", "rms", &rel),
+    let rows = [
+        (
+            "triangles",
+            show(&v["triangles"], 0),
+            show(&peer["triangles"], 0),
+        ),
+        (
+            "ms (to target)",
+            format!("{ms_to_target:.1}"),
+            show(&peer["ms"], 1),
+        ),
+        (
+            "Hausdorff / diagonal",
+            show(&v["hausdorff"], 6),
+            show(&peer["hausdorff"], 6),
+        ),
+        ("RMS / diagonal", show(&v["rms"], 6), show(&peer["rms"], 6)),
     ];
-    for (label, key, fmt) in rows {
-        let mine = if key == "ms" {
-            format!("{:.1}", ms_to_target)
-        } else {
-            cell(&v[key], fmt)
-        };
-        println!("{label:<26}{mine:>14}{:>14}", cell(&v["meshopt"][key], fmt));
+    for (label, mine, theirs) in rows {
+        println!("{label:<26}{mine:>14}{theirs:>14}");
     }
     println!("{:<26}{:>14.1}", "ms (whole sequence)", ms);
     Ok(())

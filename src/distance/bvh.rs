@@ -235,13 +235,19 @@ mod tests {
     fn bvh_agrees_with_brute_force() {
         let mut state = 12345u64;
         let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((state >> 40) as f32) / (1u64 << 24) as f32
         };
         let triangles: Vec<[Vec3; 3]> = (0..500)
             .map(|_| {
                 let o = Vec3::new(next(), next(), next()) * 10.0;
-                [o, o + Vec3::new(next(), next(), 0.0), o + Vec3::new(0.0, next(), next())]
+                [
+                    o,
+                    o + Vec3::new(next(), next(), 0.0),
+                    o + Vec3::new(0.0, next(), next()),
+                ]
             })
             .collect();
         let bvh = TriangleBvh::new(triangles.clone());

@@ -59,7 +59,11 @@ pub const DEFAULT_SAMPLES: usize = 200_000;
 /// Cost: O((T + samples) log T) on each side; the queries run on all cores.
 /// An empty `other` is infinitely far (its distances are `f64::INFINITY`).
 #[must_use]
-pub fn surface_distance(reference: Surface<'_>, other: Surface<'_>, samples: usize) -> SurfaceDistance {
+pub fn surface_distance(
+    reference: Surface<'_>,
+    other: Surface<'_>,
+    samples: usize,
+) -> SurfaceDistance {
     let diagonal = f64::from(diagonal(reference)).max(f64::MIN_POSITIVE);
     let forward = one_side(reference, other, samples, 1);
     let backward = one_side(other, reference, samples, 2);
@@ -99,7 +103,11 @@ struct Side {
 fn one_side(from: Surface<'_>, to: Surface<'_>, samples: usize, seed: u64) -> Side {
     let points = sample(from, samples, seed);
     if to.triangles.is_empty() {
-        let inf = if points.is_empty() { 0.0 } else { f64::INFINITY };
+        let inf = if points.is_empty() {
+            0.0
+        } else {
+            f64::INFINITY
+        };
         return Side {
             max: inf,
             sum2: inf,
@@ -215,8 +223,14 @@ mod tests {
         let (pa, ta) = square(0.0, 1.0);
         let (pb, tb) = square(0.25, 1.0);
         let d = surface_distance(
-            Surface { positions: &pa, triangles: &ta },
-            Surface { positions: &pb, triangles: &tb },
+            Surface {
+                positions: &pa,
+                triangles: &ta,
+            },
+            Surface {
+                positions: &pb,
+                triangles: &tb,
+            },
             1000,
         );
         let want = 0.25 / 2f64.sqrt();
@@ -232,8 +246,14 @@ mod tests {
         let (pa, ta) = square(0.0, 1.0);
         let (pb, tb) = square(0.0, 0.5);
         let d = surface_distance(
-            Surface { positions: &pa, triangles: &ta },
-            Surface { positions: &pb, triangles: &tb },
+            Surface {
+                positions: &pa,
+                triangles: &ta,
+            },
+            Surface {
+                positions: &pb,
+                triangles: &tb,
+            },
             5000,
         );
         let diag = 2f64.sqrt();
@@ -245,9 +265,20 @@ mod tests {
     #[test]
     fn sampling_covers_area_and_vertices() {
         let (p, t) = square(0.0, 2.0);
-        let s = sample(Surface { positions: &p, triangles: &t }, 10_000, 7);
+        let s = sample(
+            Surface {
+                positions: &p,
+                triangles: &t,
+            },
+            10_000,
+            7,
+        );
         assert!((10_002..=10_006).contains(&s.len()), "{}", s.len());
-        assert!(s.iter().all(|q| q.x >= 0.0 && q.x <= 2.0 && q.y >= 0.0 && q.y <= 2.0 && q.z == 0.0));
+        assert!(s.iter().all(|q| q.x >= 0.0
+            && q.x <= 2.0
+            && q.y >= 0.0
+            && q.y <= 2.0
+            && q.z == 0.0));
         // Area-uniform: about a quarter of the points in each quadrant.
         let q = s.iter().filter(|q| q.x < 1.0 && q.y < 1.0).count();
         assert!((2300..2700).contains(&q), "{q}");

@@ -72,7 +72,11 @@ impl Collapses {
         let optimal = !appended.is_empty();
         for (i, s) in steps.iter().enumerate() {
             let lod = i as u32 + 1;
-            let target = if optimal { (vertex_count + i) as u32 } else { s.kept };
+            let target = if optimal {
+                (vertex_count + i) as u32
+            } else {
+                s.kept
+            };
             parent[s.removed as usize] = target;
             parent_from_lod[s.removed as usize] = lod;
             if optimal {
@@ -228,7 +232,11 @@ impl Collapses {
     /// count differs) or `lod > max_lod()`.
     #[must_use]
     pub fn triangles_at(&self, mesh: &Mesh, lod: usize) -> Vec<[u32; 3]> {
-        assert_eq!(mesh.vertex_count(), self.vertex_count, "Collapses used with another mesh");
+        assert_eq!(
+            mesh.vertex_count(),
+            self.vertex_count,
+            "Collapses used with another mesh"
+        );
         assert!(lod <= self.max_lod(), "LoD {lod} beyond {}", self.max_lod());
         let rep = self.representatives(lod);
         mesh.triangles
@@ -244,7 +252,12 @@ impl Collapses {
     #[must_use]
     pub fn mesh_at(&self, mesh: &Mesh, lod: usize) -> Mesh {
         let triangles = self.triangles_at(mesh, lod);
-        let all: Vec<Vec3> = mesh.positions.iter().chain(&self.appended).copied().collect();
+        let all: Vec<Vec3> = mesh
+            .positions
+            .iter()
+            .chain(&self.appended)
+            .copied()
+            .collect();
         compact(&all, &triangles)
     }
 
@@ -254,7 +267,11 @@ impl Collapses {
     /// With a message naming the first broken invariant.
     pub fn validate(&self) {
         let total = self.vertex_count + self.appended.len();
-        assert_eq!(self.triangle_counts.len(), self.steps.len() + 1, "table length");
+        assert_eq!(
+            self.triangle_counts.len(),
+            self.steps.len() + 1,
+            "table length"
+        );
         assert!(
             self.triangle_counts.windows(2).all(|w| w[0] >= w[1]),
             "triangle counts increase"
@@ -264,16 +281,33 @@ impl Collapses {
         let mut last_error = 0.0f32;
         for (i, s) in self.steps.iter().enumerate() {
             let (r, k) = (s.removed as usize, s.kept as usize);
-            assert!(r < total && k < total && r != k, "step {i}: bad vertices {s:?}");
-            assert_eq!(removed_at[r], u32::MAX, "step {i}: vertex {r} removed twice");
-            assert_eq!(removed_at[k], u32::MAX, "step {i}: kept vertex {k} already removed");
+            assert!(
+                r < total && k < total && r != k,
+                "step {i}: bad vertices {s:?}"
+            );
+            assert_eq!(
+                removed_at[r],
+                u32::MAX,
+                "step {i}: vertex {r} removed twice"
+            );
+            assert_eq!(
+                removed_at[k],
+                u32::MAX,
+                "step {i}: kept vertex {k} already removed"
+            );
             removed_at[r] = i as u32;
             let target = self.target(i);
             if self.is_optimal_placement() {
                 removed_at[k] = i as u32;
-                assert_eq!(self.parent[k], target, "step {i}: forest link of the kept endpoint");
+                assert_eq!(
+                    self.parent[k], target,
+                    "step {i}: forest link of the kept endpoint"
+                );
             }
-            assert!(s.error.is_finite() && s.error >= last_error, "step {i}: error decreases");
+            assert!(
+                s.error.is_finite() && s.error >= last_error,
+                "step {i}: error decreases"
+            );
             last_error = s.error;
             assert_eq!(self.parent[r], target, "step {i}: forest link");
         }

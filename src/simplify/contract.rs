@@ -52,20 +52,19 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     c.finish()
 }
 
-/// A queue entry: contract `removed` into `kept` (or both into a new vertex
-/// in optimal mode) at quadric cost `cost`.
+/// A queue entry: the cheapest allowed contraction of `vertex` (into
+/// `target`, or both into a new vertex in optimal mode) at cost `cost`.
 #[derive(Clone, Copy)]
 struct Entry {
     cost: f32,
-    removed: u32,
-    kept: u32,
-    /// `version[removed] + version[kept]` when queued; bit 31 marks an entry
-    /// already tried in the other direction.
+    vertex: u32,
+    target: u32,
+    /// `version[vertex]` when queued: the entry is current while it holds.
     stamp: u32,
 }
 
-const REVERSED: u32 = 1 << 31;
-
+/// "No target" in [`Contractor::queued`].
+const NONE: u32 = u32::MAX;
 
 impl PartialEq for Entry {
     fn eq(&self, other: &Entry) -> bool {
@@ -85,8 +84,8 @@ impl Ord for Entry {
         other
             .cost
             .total_cmp(&self.cost)
-            .then(other.removed.cmp(&self.removed))
-            .then(other.kept.cmp(&self.kept))
+            .then(other.vertex.cmp(&self.vertex))
+            .then(other.target.cmp(&self.target))
     }
 }
 
@@ -119,7 +118,14 @@ struct Contractor {
     mark: Vec<u32>,
     epoch: u32,
     heap: BinaryHeap<Entry>,
-    deferred: Vec<(u32, u32)>,
+    /// The (cost, target) of each vertex's current queue entry.
+    queued: Vec<(f32, u32)>,
+    /// Targets a guard refused for each vertex since its neighbourhood last
+    /// changed; `blocked_count` counts them all.
+    blocked: Vec<Vec<u32>>,
+    blocked_count: usize,
+    /// Scratch vertex list (neighbours of a survivor).
+    ring: Vec<u32>,
     /// Output.
     steps: Vec<Collapse>,
     triangle_counts: Vec<u32>,
@@ -227,7 +233,10 @@ impl Contractor {
             mark: vec![0; n],
             epoch: 0,
             heap: BinaryHeap::new(),
-            deferred: Vec::new(),
+            queued: vec![(f32::NAN, NONE); n],
+            blocked: vec![Vec::new(); n],
+            blocked_count: 0,
+            ring: Vec::new(),
             steps: Vec::new(),
             triangle_counts: vec![triangles_now],
             appended: Vec::new(),
@@ -237,15 +246,9 @@ impl Contractor {
             input_vertices: n,
             scratch: Vec::new(),
         };
-        let mut entries = Vec::with_capacity(c.tris.len() * 3 / 2 + 16);
-        for a in 0..n as u32 {
-            c.for_each_partner(a, |c, b| {
-                if b > a {
-                    entries.push(c.entry(a, b));
-                }
-            });
+        for v in 0..n as u32 {
+            c.refresh(v);
         }
-        c.heap = BinaryHeap::from(entries);
         c
     }
 
@@ -285,23 +288,77 @@ impl Contractor {
         self.epoch
     }
 
-    /// The queue entry for pair `(a, b)` in its cheaper direction.
-    fn entry(&self, a: u32, b: u32) -> Entry {
-        let q = self.quadrics[a as usize] + self.quadrics[b as usize];
-        let stamp = self.stamp(a, b);
-        match self.placement {
-            Placement::Endpoint => {
-                let keep_a = self.cost(b, a);
-                let keep_b = self.cost(a, b);
-                if keep_b <= keep_a {
-                    Entry { cost: keep_b as f32, removed: a, kept: b, stamp }
-                } else {
-                    Entry { cost: keep_a as f32, removed: b, kept: a, stamp }
-                }
+    /// The cheapest target of `v` among its neighbours and virtual
+    /// partners that no guard refused yet: `(cost, target)`.
+    fn best(&mut self, v: u32) -> Option<(f64, u32)> {
+        let mut best: Option<(f64, u32)> = None;
+        let blocked = std::mem::take(&mut self.blocked[v as usize]);
+        self.for_each_partner(v, |c, w| {
+            if blocked.contains(&w) {
+                return;
             }
+            let cost = c.pair_cost(v, w);
+            if best.is_none_or(|(bc, bw)| cost < bc || (cost == bc && w < bw)) {
+                best = Some((cost, w));
+            }
+        });
+        self.blocked[v as usize] = blocked;
+        best
+    }
+
+    /// Recomputes `v`'s cheapest contraction and queues it when it changed
+    /// (the old entry then goes stale).
+    fn refresh(&mut self, v: u32) {
+        // Drop the triangles that died around `v` while it stayed.
+        let mut list = std::mem::take(&mut self.vertex_tris[v as usize]);
+        list.retain(|&t| self.alive[t as usize]);
+        self.vertex_tris[v as usize] = list;
+        let new = self
+            .best(v)
+            .map_or((f32::INFINITY, NONE), |(c, w)| (c as f32, w));
+        let old = self.queued[v as usize];
+        if new.0 == old.0 && new.1 == old.1 {
+            return;
+        }
+        self.queued[v as usize] = new;
+        let version = &mut self.version[v as usize];
+        *version = version.wrapping_add(1);
+        if new.1 != NONE {
+            self.heap.push(Entry {
+                cost: new.0,
+                vertex: v,
+                target: new.1,
+                stamp: *version,
+            });
+        }
+    }
+
+    /// Queues `v → w` if it is cheaper than `v`'s queued contraction.
+    fn offer(&mut self, v: u32, w: u32) {
+        let cost = self.pair_cost(v, w) as f32;
+        let (old_cost, old_target) = self.queued[v as usize];
+        if old_target == w || cost > old_cost || (cost == old_cost && w > old_target) {
+            return;
+        }
+        self.queued[v as usize] = (cost, w);
+        let version = &mut self.version[v as usize];
+        *version = version.wrapping_add(1);
+        self.heap.push(Entry {
+            cost,
+            vertex: v,
+            target: w,
+            stamp: *version,
+        });
+    }
+
+    /// Cost of contracting `v` with `w`: moving `v` onto `w`, or in optimal
+    /// mode both onto the merged quadric's best point.
+    fn pair_cost(&self, v: u32, w: u32) -> f64 {
+        match self.placement {
+            Placement::Endpoint => self.cost(v, w),
             Placement::Optimal => {
-                let (_, cost) = self.optimal_point(&q, a, b);
-                Entry { cost: cost as f32, removed: a, kept: b, stamp }
+                let q = self.quadrics[v as usize] + self.quadrics[w as usize];
+                self.optimal_point(&q, v, w).1
             }
         }
     }
@@ -316,10 +373,6 @@ impl Contractor {
     fn cost(&self, removed: u32, kept: u32) -> f64 {
         let q = &self.quadrics[removed as usize];
         q.evaluate(self.pos[kept as usize]) / q.weight().max(f64::MIN_POSITIVE)
-    }
-
-    fn stamp(&self, a: u32, b: u32) -> u32 {
-        self.version[a as usize].wrapping_add(self.version[b as usize]) & !REVERSED
     }
 
     /// The quadric's minimiser, or the best of the endpoints and midpoint.
@@ -341,63 +394,61 @@ impl Contractor {
         let mut round_start = 0;
         loop {
             if stop_at.is_some_and(|t| self.triangles_now as usize <= t) {
-                self.stop = Some(self.stop_record(StopReason::TargetReached, RoundStats::default()));
+                self.stop =
+                    Some(self.stop_record(StopReason::TargetReached, RoundStats::default()));
                 return;
             }
             let Some(e) = self.heap.pop() else {
-                // A round ends. Pairs deferred in it may have become valid
-                // since; try them again unless the round changed nothing.
-                if self.steps.len() == round_start || self.deferred.is_empty() {
+                // A round ends. Refused pairs may have become valid since
+                // (a guard looks at more than the two vertices' own
+                // neighbourhoods); try everything again unless the round
+                // changed nothing.
+                if self.steps.len() == round_start || self.blocked_count == 0 {
                     self.stop = Some(self.stop_record(StopReason::NoValidPair, round));
                     return;
                 }
-                self.requeue_deferred();
+                self.requeue_all();
                 round_start = self.steps.len();
                 round = RoundStats::default();
                 continue;
             };
-            let (a, b) = (e.removed, e.kept);
-            if self.removed[a as usize]
-                || self.removed[b as usize]
-                || self.stamp(a, b) != e.stamp & !REVERSED
-            {
+            let (a, b) = (e.vertex, e.target);
+            if self.removed[a as usize] || self.version[a as usize] != e.stamp {
+                continue;
+            }
+            if self.removed[b as usize] {
+                // The target went away without `a` being next to its
+                // survivor (their shared triangles died with it).
+                self.refresh(a);
                 continue;
             }
             let target = self.target_position(a, b);
             match self.check(a, b, target) {
                 Ok(()) => self.contract(a, b, target, e.cost),
-                Err(_) if e.stamp & REVERSED == 0 && self.placement == Placement::Endpoint => {
-                    // Try the other direction at its own cost.
-                    self.heap.push(Entry {
-                        cost: self.cost(b, a) as f32,
-                        removed: b,
-                        kept: a,
-                        stamp: e.stamp | REVERSED,
-                    });
-                }
                 Err(why) => {
                     round.candidates += 1;
                     match why {
                         Reject::Flip => round.flip += 1,
                         Reject::Fin => round.fin += 1,
                     }
-                    self.deferred.push((a.min(b), a.max(b)));
+                    self.blocked[a as usize].push(b);
+                    self.blocked_count += 1;
+                    self.refresh(a);
                 }
             }
         }
     }
 
-    /// Queues every deferred pair whose vertices are both still present.
-    fn requeue_deferred(&mut self) {
-        let mut pairs = std::mem::take(&mut self.deferred);
-        pairs.sort_unstable();
-        pairs.dedup();
-        for (a, b) in pairs {
-            if !self.removed[a as usize] && !self.removed[b as usize] {
-                let e = self.entry(a, b);
-                self.heap.push(e);
+    /// Forgets every refusal and queues every live vertex again.
+    fn requeue_all(&mut self) {
+        for v in 0..self.pos.len() as u32 {
+            self.blocked[v as usize].clear();
+            if !self.removed[v as usize] {
+                self.queued[v as usize] = (f32::NAN, NONE);
+                self.refresh(v);
             }
         }
+        self.blocked_count = 0;
     }
 
     /// Where the surviving vertex of `a → b` goes.
@@ -455,10 +506,13 @@ impl Contractor {
         }
         for &t in &self.vertex_tris[b as usize] {
             let tri = self.tris[t as usize];
-            if self.alive[t as usize] && !tri.contains(&a) {
-                if tri.iter().any(|&w| w != b && self.mark[w as usize] == epoch) {
-                    return Err(Reject::Fin);
-                }
+            if self.alive[t as usize]
+                && !tri.contains(&a)
+                && tri
+                    .iter()
+                    .any(|&w| w != b && self.mark[w as usize] == epoch)
+            {
+                return Err(Reject::Fin);
             }
         }
         // Triangles of `a` that survive: no duplicate of a triangle of `b`,
@@ -541,6 +595,15 @@ impl Contractor {
     /// Applies `a → b` (or both into a new vertex at `target`) and queues
     /// the pairs around the survivor again.
     fn contract(&mut self, a: u32, b: u32, target: DVec3, cost: f32) {
+        // Who must choose again afterwards: in endpoint mode the survivor
+        // and `a`'s neighbours (they lose `a` as a target); `b`'s other
+        // neighbours keep their candidates and costs, so only those that a
+        // guard refused something are asked again. In optimal mode every
+        // neighbour sees a new vertex.
+        let mut ring = std::mem::take(&mut self.ring);
+        ring.clear();
+        ring.push(b);
+        self.for_each_partner(a, |_, w| ring.push(w));
         let q = self.quadrics[a as usize] + self.quadrics[b as usize];
         let survivor = match self.placement {
             Placement::Endpoint => b,
@@ -552,6 +615,8 @@ impl Contractor {
                 self.removed.push(false);
                 self.version.push(0);
                 self.mark.push(0);
+                self.queued.push((f32::NAN, NONE));
+                self.blocked.push(Vec::new());
                 if !self.partners.is_empty() {
                     self.partners.push(Vec::new());
                 }
@@ -560,28 +625,29 @@ impl Contractor {
             }
         };
         self.quadrics[survivor as usize] = q;
-        let mut merged = Vec::with_capacity(
-            self.vertex_tris[a as usize].len() + self.vertex_tris[b as usize].len(),
-        );
+        // b's list is reused in place: its live triangles without `a`,
+        // then `a`'s survivors (which never contain `b`).
+        let mut merged = std::mem::take(&mut self.vertex_tris[b as usize]);
         let mut dead = 0u32;
-        for &t in &self.vertex_tris[b as usize] {
-            let tri = &mut self.tris[t as usize];
+        merged.retain(|&t| {
             if !self.alive[t as usize] {
-                continue;
+                return false;
             }
+            let tri = &mut self.tris[t as usize];
             if tri.contains(&a) {
                 self.alive[t as usize] = false;
                 dead += 1;
-                continue;
+                return false;
             }
             for w in tri.iter_mut() {
                 if *w == b {
                     *w = survivor;
                 }
             }
-            merged.push(t);
-        }
-        for &t in &self.vertex_tris[a as usize] {
+            true
+        });
+        let from_a = std::mem::take(&mut self.vertex_tris[a as usize]);
+        for &t in &from_a {
             if !self.alive[t as usize] {
                 continue;
             }
@@ -592,9 +658,7 @@ impl Contractor {
             }
             merged.push(t);
         }
-        self.vertex_tris[a as usize] = Vec::new();
         if survivor != b {
-            self.vertex_tris[b as usize] = Vec::new();
             self.removed[b as usize] = true;
         }
         self.vertex_tris[survivor as usize] = merged;
@@ -616,6 +680,12 @@ impl Contractor {
             self.partners[survivor as usize] = list;
         }
         self.removed[a as usize] = true;
+        for gone in [a, b] {
+            if gone != survivor {
+                self.blocked_count -= self.blocked[gone as usize].len();
+                self.blocked[gone as usize] = Vec::new();
+            }
+        }
         self.version[a as usize] = self.version[a as usize].wrapping_add(1);
         self.version[b as usize] = self.version[b as usize].wrapping_add(1);
         self.triangles_now -= dead;
@@ -627,10 +697,40 @@ impl Contractor {
             error: self.max_error,
         });
         self.triangle_counts.push(self.triangles_now);
+        // The survivor's quadric changed; its neighbours lost `a` (and in
+        // optimal mode `b`) as a target and gained the survivor, and what
+        // the guards refused them may be allowed now.
+        if survivor != b {
+            ring.clear();
+            ring.push(survivor);
+        }
+        let everyone = survivor != b;
         self.for_each_partner(survivor, |c, w| {
-            let e = c.entry(survivor, w);
-            c.heap.push(e);
+            if everyone || !c.blocked[w as usize].is_empty() {
+                ring.push(w);
+            }
         });
+        for &v in &ring {
+            if self.removed[v as usize] {
+                continue;
+            }
+            let (_, queued_target) = self.queued[v as usize];
+            let full = v == survivor
+                || everyone
+                || queued_target == a
+                || queued_target == NONE
+                || !self.blocked[v as usize].is_empty();
+            if full {
+                self.blocked_count -= self.blocked[v as usize].len();
+                self.blocked[v as usize].clear();
+                self.refresh(v);
+            } else {
+                // Only the survivor is new among `v`'s targets, and no other
+                // cost changed: compare it with the queued one.
+                self.offer(v, survivor);
+            }
+        }
+        self.ring = ring;
     }
 
     fn stop_record(&mut self, reason: StopReason, round: RoundStats) -> Stop {

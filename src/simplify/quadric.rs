@@ -168,8 +168,12 @@ mod tests {
 
     #[test]
     fn triangle_weight_is_its_area() {
-        let q = Quadric::triangle(Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0))
-            .unwrap();
+        let q = Quadric::triangle(
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 3.0, 0.0),
+        )
+        .unwrap();
         assert!((q.weight() - 3.0).abs() < 1e-12);
         assert!(Quadric::triangle(Vec3::ZERO, Vec3::X, Vec3::X * 2.0).is_none());
     }

@@ -1,0 +1,358 @@
+//! The contraction sequence: hand-made meshes with a known outcome, the
+//! per-LoD invariants on random meshes (valid indices, no flipped normal,
+//! non-increasing counts, consistent representatives), and real models.
+
+use glam::Vec3;
+use mts::distance::{surface_distance, Surface};
+use mts::mesh::io::{load, LoadOptions};
+use mts::mesh::Mesh;
+use mts::simplify::{Placement, SimplifyOptions, StopReason};
+use mts::{peers, simplify, Collapses};
+use proptest::prelude::*;
+use std::path::Path;
+
+/// A flat `n × n` grid of unit squares in the z = 0 plane, CCW from +z.
+fn flat_grid(n: u32) -> Mesh {
+    let id = |x: u32, y: u32| y * (n + 1) + x;
+    let positions = (0..=n)
+        .flat_map(|y| (0..=n).map(move |x| Vec3::new(x as f32, y as f32, 0.0)))
+        .collect();
+    let mut triangles = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            triangles.push([id(x, y), id(x + 1, y), id(x + 1, y + 1)]);
+            triangles.push([id(x, y), id(x + 1, y + 1), id(x, y + 1)]);
+        }
+    }
+    Mesh {
+        positions,
+        triangles,
+    }
+}
+
+/// Checks every LoD against the naive replay and returns nothing: indices
+/// valid, counts as recorded and non-increasing, representatives agree
+/// with the forest walk, no triangle turned against its input normal.
+fn check_every_lod(mesh: &Mesh, c: &Collapses) {
+    c.validate();
+    let n = mesh.vertex_count() + c.appended().len();
+    let positions: Vec<Vec3> = mesh.positions.iter().chain(c.appended()).copied().collect();
+    let mut previous = usize::MAX;
+    for lod in 0..=c.max_lod() {
+        let rep = c.representatives(lod);
+        for v in 0..n as u32 {
+            assert_eq!(
+                rep[v as usize],
+                c.representative(v, lod),
+                "pc-rep of {v} at {lod}"
+            );
+        }
+        let tris = c.triangles_at(mesh, lod);
+        assert_eq!(tris.len(), c.triangle_count(lod), "count at LoD {lod}");
+        assert!(tris.len() <= previous, "count grows at LoD {lod}");
+        previous = tris.len();
+        let mut kept = 0;
+        for (t, input) in mesh.triangles.iter().enumerate() {
+            let now = input.map(|v| rep[v as usize]);
+            if mts::mesh::is_degenerate(now) {
+                continue;
+            }
+            kept += 1;
+            assert!(now.iter().all(|&v| (v as usize) < n));
+            let normal = |t: [u32; 3]| {
+                let [a, b, c] = t.map(|v| positions[v as usize]);
+                (b - a).cross(c - a)
+            };
+            let (n0, n1) = (normal(*input), normal(now));
+            if n0.length() > 1e-12 && n1.length() > 1e-12 {
+                assert!(
+                    n0.normalize().dot(n1.normalize()) > 0.0,
+                    "triangle {t} flipped at LoD {lod}: {input:?} -> {now:?}"
+                );
+            }
+        }
+        assert_eq!(kept, tris.len());
+    }
+}
+
+#[test]
+fn flat_grid_keeps_its_square_with_zero_error() {
+    // 4x4 squares, 32 triangles, all in one plane:
+    //   12--13--14--15--16
+    //   |  / |  / |  / |  /|      every interior or straight-border vertex
+    //   ...                      can go at zero cost; the four corners
+    //   0 --1 --2 --3 --4        cannot without cutting the square.
+    let mesh = flat_grid(4);
+    let s = simplify(&mesh, &SimplifyOptions::default());
+    let c = &s.collapses;
+    check_every_lod(&mesh, c);
+    // Two triangles (the square itself) are reached with no error at all...
+    let lod = c.lod_for_triangles(2);
+    assert_eq!(c.triangle_count(lod), 2);
+    assert_eq!(c.error(lod), 0.0);
+    let mut corners: Vec<u32> = c.triangles_at(&mesh, lod).into_iter().flatten().collect();
+    corners.sort_unstable();
+    corners.dedup();
+    assert_eq!(corners, vec![0, 4, 20, 24]);
+    let d = surface_distance(
+        (&mesh).into(),
+        Surface {
+            positions: &mesh.positions,
+            triangles: &c.triangles_at(&mesh, lod),
+        },
+        2000,
+    );
+    assert!(d.hausdorff < 1e-6, "{d:?}");
+    // ...and only cutting a corner costs something.
+    assert!(c.error(lod + 1) > 0.0);
+    assert_eq!(s.stop.reason, StopReason::NoValidPair);
+}
+
+#[test]
+fn tetrahedron_cannot_contract() {
+    // Any contraction of a tetrahedron leaves two triangles on the same
+    // three vertices (a fin): the sequence is empty.
+    let mesh = Mesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
+        triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+    };
+    let s = simplify(&mesh, &SimplifyOptions::default());
+    assert_eq!(s.collapses.max_lod(), 0);
+    assert_eq!(s.stop.reason, StopReason::NoValidPair);
+    assert_eq!(s.stop.triangles, 4);
+    assert_eq!(s.stop.rejected_fin, s.stop.candidates_left);
+    assert!(s.stop.candidates_left >= 4);
+}
+
+#[test]
+fn spike_goes_after_every_free_contraction() {
+    // A flat 4x4 grid whose centre vertex (12) is raised: the vertices far
+    // from it are free to go (error 0), the spike is expensive, so it is
+    // removed only after every free contraction, and its removal raises
+    // the error.
+    let mut mesh = flat_grid(4);
+    mesh.positions[12].z = 2.0;
+    let s = simplify(&mesh, &SimplifyOptions::default());
+    let c = &s.collapses;
+    check_every_lod(&mesh, c);
+    let free = c.steps().iter().take_while(|st| st.error == 0.0).count();
+    assert!(free >= 4, "{free} free contractions");
+    let spike = c
+        .steps()
+        .iter()
+        .position(|st| st.removed == 12)
+        .unwrap_or(c.max_lod());
+    assert!(
+        spike >= free,
+        "spike removed at step {spike}, before free step {free}"
+    );
+    if spike < c.max_lod() {
+        assert!(c.error(spike + 1) > c.error(spike));
+    }
+}
+
+#[test]
+fn stop_at_target_is_a_prefix_of_the_whole_sequence() {
+    let mesh = mts::mesh::generate::icosphere(8, 0.1, 3);
+    let whole = simplify(&mesh, &SimplifyOptions::default());
+    let options = SimplifyOptions {
+        stop_at_triangles: Some(100),
+        ..SimplifyOptions::default()
+    };
+    let part = simplify(&mesh, &options);
+    assert_eq!(part.stop.reason, StopReason::TargetReached);
+    assert!(part.stop.triangles <= 100);
+    let k = part.collapses.max_lod();
+    assert_eq!(part.collapses.steps(), &whole.collapses.steps()[..k]);
+    assert_eq!(whole.collapses.lod_for_triangles(part.stop.triangles), k);
+    // Closed genus-0 surface: it ends at a tetrahedron-like hull.
+    assert_eq!(whole.stop.reason, StopReason::NoValidPair);
+    assert!(whole.stop.triangles >= 4, "{}", whole.stop);
+}
+
+#[test]
+fn lod_lookup_by_budget_and_ratio() {
+    let mesh = flat_grid(6);
+    let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
+    assert_eq!(c.lod_for_triangles(72), 0);
+    assert_eq!(c.lod_for_triangles(usize::MAX), 0);
+    for budget in 0..72 {
+        let k = c.lod_for_triangles(budget);
+        if c.triangle_count(c.max_lod()) <= budget {
+            assert!(c.triangle_count(k) <= budget);
+            assert!(k == 0 || c.triangle_count(k - 1) > budget);
+        } else {
+            assert_eq!(k, c.max_lod());
+        }
+    }
+    assert_eq!(c.lod_for_ratio(1.0), 0);
+    assert_eq!(c.lod_for_ratio(0.5), c.lod_for_triangles(36));
+    assert_eq!(c.lod_for_ratio(7.0), 0);
+}
+
+#[test]
+fn optimal_placement_appends_vertices_and_keeps_the_invariants() {
+    let mesh = mts::mesh::generate::icosphere(6, 0.2, 9);
+    let options = SimplifyOptions {
+        placement: Placement::Optimal,
+        ..SimplifyOptions::default()
+    };
+    let c = simplify(&mesh, &options).collapses;
+    assert!(c.is_optimal_placement());
+    assert_eq!(c.appended().len(), c.max_lod());
+    check_every_lod(&mesh, &c);
+    let m = c.mesh_at(&mesh, c.lod_for_ratio(0.25));
+    m.validate().unwrap();
+}
+
+/// A random open surface: a height field over a grid with random holes,
+/// triangles flipped or duplicated, and a second flat component.
+fn random_surface() -> impl Strategy<Value = Mesh> {
+    (2u32..10, 2u32..10, prop::collection::vec(0u8..20, 400)).prop_map(|(w, h, dice)| {
+        let mut d = dice.iter().cycle();
+        let mut roll = || *d.next().unwrap();
+        let id = |x: u32, y: u32| y * (w + 1) + x;
+        let mut positions = Vec::new();
+        for y in 0..=h {
+            for x in 0..=w {
+                let z = f32::from(roll()) * 0.05;
+                positions.push(Vec3::new(x as f32, y as f32, z));
+            }
+        }
+        let mut triangles = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let (a, b, c, e) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
+                for t in [[a, b, c], [a, c, e]] {
+                    match roll() {
+                        0 => {}
+                        1 => triangles.push([t[0], t[2], t[1]]),
+                        2 => {
+                            triangles.push(t);
+                            triangles.push(t);
+                        }
+                        _ => triangles.push(t),
+                    }
+                }
+            }
+        }
+        let base = positions.len() as u32;
+        positions.extend([
+            Vec3::new(0.0, 0.0, 5.0),
+            Vec3::new(1.0, 0.0, 5.0),
+            Vec3::new(1.0, 1.0, 5.0),
+            Vec3::new(0.0, 1.0, 5.0),
+        ]);
+        triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+        let raw = mts::mesh::RawMesh {
+            positions,
+            triangles,
+            degenerate_in_source: 0,
+        };
+        mts::mesh::clean(raw, Default::default(), "random")
+            .unwrap()
+            .0
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn every_lod_of_random_surfaces_is_valid(m in random_surface()) {
+        let s = simplify(&m, &SimplifyOptions::default());
+        check_every_lod(&m, &s.collapses);
+        prop_assert_eq!(s.stop.lod, s.collapses.max_lod());
+        prop_assert_eq!(s.stop.triangles, s.collapses.triangle_count(s.stop.lod));
+    }
+
+    #[test]
+    fn virtual_pairs_keep_the_invariants(m in random_surface()) {
+        let options = SimplifyOptions { pair_distance: Some(0.3), ..SimplifyOptions::default() };
+        let s = simplify(&m, &options);
+        check_every_lod(&m, &s.collapses);
+    }
+}
+
+fn model(name: &str) -> Option<Mesh> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/models")
+        .join(name);
+    if !path.exists() {
+        eprintln!(
+            "skipped: {} not found (needs ../shared/models)",
+            path.display()
+        );
+        return None;
+    }
+    Some(load(&path, LoadOptions::default()).unwrap().0)
+}
+
+#[test]
+fn bunny_error_against_meshoptimizer() {
+    let Some(mesh) = model("bunny.ply") else {
+        return;
+    };
+    let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
+    c.validate();
+    for ratio in [0.1, 0.01] {
+        let lod = c.lod_for_ratio(ratio);
+        let ours = c.triangles_at(&mesh, lod);
+        let theirs = peers::meshopt::simplify(&mesh, ours.len());
+        assert!(ours.len() <= (ratio * 69451.0).round() as usize);
+        let measure = |t: &[[u32; 3]]| {
+            surface_distance(
+                (&mesh).into(),
+                Surface {
+                    positions: &mesh.positions,
+                    triangles: t,
+                },
+                50_000,
+            )
+        };
+        let (a, b) = (measure(&ours), measure(&theirs));
+        assert!(
+            a.hausdorff <= 1.15 * b.hausdorff,
+            "ratio {ratio}: Hausdorff {} against meshopt {}",
+            a.hausdorff,
+            b.hausdorff
+        );
+        assert!(
+            a.rms <= 1.15 * b.rms,
+            "ratio {ratio}: RMS {} against {}",
+            a.rms,
+            b.rms
+        );
+    }
+}
+
+#[test]
+fn open_models_keep_their_borders() {
+    // Border vertices only move along border edges, so at 10% every border
+    // vertex of the LoD is an input border vertex and stays put.
+    let Some(mesh) = model("bunny.ply") else {
+        return;
+    };
+    let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
+    let border = |tris: &[[u32; 3]]| {
+        let mut count = std::collections::HashMap::new();
+        for t in tris {
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        let mut v: Vec<u32> = count
+            .into_iter()
+            .filter(|&(_, c)| c == 1)
+            .flat_map(|((a, b), _)| [a, b])
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let input = border(&mesh.triangles);
+    let at = border(&c.triangles_at(&mesh, c.lod_for_ratio(0.1)));
+    assert!(!at.is_empty());
+    assert!(at.iter().all(|v| input.binary_search(v).is_ok()));
+}
