@@ -297,6 +297,10 @@ impl Collapses {
             );
             removed_at[r] = i as u32;
             let target = self.target(i);
+            assert!(
+                !self.is_optimal_placement() || (r.max(k) < target as usize),
+                "step {i}: uses a vertex created later"
+            );
             if self.is_optimal_placement() {
                 removed_at[k] = i as u32;
                 assert_eq!(

@@ -2,29 +2,37 @@
 //! Simplification Using Quadric Error Metrics", SIGGRAPH 1997), recorded
 //! step by step as [`Collapses`].
 //!
-//! Decisions where the paper leaves room:
-//! - **Costs are area-weighted quadric errors** (section 6: planes weighted
-//!   by triangle area), compared raw in the queue; the recorded error is
-//!   the root-mean-square plane distance `sqrt(cost / area)` relative to
-//!   the bounding-box diagonal, as a running maximum so it never decreases.
-//! - **Lazy invalidation**: a queue entry carries the sum of its two
-//!   vertices' version counters; a contraction bumps both endpoints, so an
-//!   entry is current exactly when the sum is unchanged (counters only grow).
-//! - **A rejected pair is retried in its other direction, then deferred.**
-//!   Its validity can change when a neighbour moves without its own entry
-//!   being refreshed, so when the queue runs dry every deferred pair is
-//!   queued again; the sequence ends after a round with no contraction.
+//! Decisions where the paper leaves room (measurements in
+//! `ARCHITECTURE.md`, "Simplification"):
+//! - **Costs after meshoptimizer**: moving `a` onto `b` costs the *mean*
+//!   squared distance from `b` to `a`'s accumulated planes (see
+//!   [`Contractor::cost`]); face planes weigh `sqrt(area)`. The recorded
+//!   error is the square root of that cost relative to the bounding-box
+//!   diagonal, as a running maximum so it never decreases.
+//! - **One queue entry per vertex**: its cheapest allowed target, stamped
+//!   with a per-vertex version; refreshing a vertex bumps the version, so
+//!   older entries go stale. After `a → b` the survivor and `a`'s
+//!   neighbours choose again; `b`'s other neighbours keep their choice.
+//! - **A refused target is remembered per vertex** until its
+//!   neighbourhood changes, and the vertex picks its next best. Validity
+//!   can also change farther away, so when the queue runs dry every refusal
+//!   is forgotten and every vertex queued again; the sequence ends after a
+//!   round with no contraction.
 //! - **Flips are judged against both the current and the original normal**
-//!   of every moved triangle: a sequence of small turns could otherwise
-//!   fold a triangle over, and every LoD must keep the input's orientation.
+//!   of every moved triangle (75° at most against the current one, 90°
+//!   against the input's): a series of small turns could otherwise fold a
+//!   triangle over, and every LoD must keep the input's orientation.
 //! - **Fins**: a contraction is rejected when a vertex adjacent to both
 //!   endpoints is not the apex of a triangle on the contracted edge (the
 //!   link condition: the edge to it would gain triangles), or when two
 //!   triangles would end up on the same three vertices (the tetrahedron
 //!   case the link condition alone lets through).
-//! - **Boundaries**: every edge without an orientation-consistent neighbour
+//! - **Borders**: every edge without an orientation-consistent neighbour
 //!   (see [`TriangleAdjacency`]) adds a plane through it, perpendicular to
-//!   its triangle, to both endpoints' quadrics.
+//!   its triangle, to both endpoints' quadrics (weight `boundary_weight ×
+//!   length`, plus the triangle's own plane counted in the error but not
+//!   in the mean's weight); a vertex on an edge with other than two
+//!   triangles leaves only along such an edge.
 
 use super::collapses::{Collapse, Collapses};
 use super::pairs::{vertex_triangles, virtual_pairs};
