@@ -120,7 +120,7 @@ fn tetrahedron_cannot_contract() {
     assert_eq!(s.collapses.max_lod(), 0);
     assert_eq!(s.stop.reason, StopReason::NoValidPair);
     assert_eq!(s.stop.triangles, 4);
-    assert_eq!(s.stop.rejected_fin, s.stop.candidates_left);
+    assert_eq!(s.stop.rejected_topology, s.stop.candidates_left);
     assert!(s.stop.candidates_left >= 4);
 }
 

@@ -205,34 +205,24 @@ impl SplitMix {
 mod tests {
     use super::*;
 
-    fn square(z: f32, size: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-        (
-            vec![
+    /// A `size × size` square at height `z`, two triangles.
+    fn square(z: f32, size: f32) -> crate::Mesh {
+        crate::Mesh {
+            positions: vec![
                 Vec3::new(0.0, 0.0, z),
                 Vec3::new(size, 0.0, z),
                 Vec3::new(size, size, z),
                 Vec3::new(0.0, size, z),
             ],
-            vec![[0, 1, 2], [0, 2, 3]],
-        )
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        }
     }
 
     #[test]
     fn parallel_squares_are_exactly_their_offset_apart() {
         // Two unit squares 0.25 apart: every sample is 0.25 from the other.
-        let (pa, ta) = square(0.0, 1.0);
-        let (pb, tb) = square(0.25, 1.0);
-        let d = surface_distance(
-            Surface {
-                positions: &pa,
-                triangles: &ta,
-            },
-            Surface {
-                positions: &pb,
-                triangles: &tb,
-            },
-            1000,
-        );
+        let (a, b) = (square(0.0, 1.0), square(0.25, 1.0));
+        let d = surface_distance((&a).into(), (&b).into(), 1000);
         let want = 0.25 / 2f64.sqrt();
         assert!((d.hausdorff - want).abs() < 1e-6, "{d:?}");
         assert!((d.rms - want).abs() < 1e-6, "{d:?}");
@@ -243,19 +233,8 @@ mod tests {
         // A unit square against its lower-left quarter: from the quarter
         // everything is on the square (0); from the square, the far corner
         // (1, 1) is sqrt(0.5) from the quarter's corner (0.5, 0.5).
-        let (pa, ta) = square(0.0, 1.0);
-        let (pb, tb) = square(0.0, 0.5);
-        let d = surface_distance(
-            Surface {
-                positions: &pa,
-                triangles: &ta,
-            },
-            Surface {
-                positions: &pb,
-                triangles: &tb,
-            },
-            5000,
-        );
+        let (a, b) = (square(0.0, 1.0), square(0.0, 0.5));
+        let d = surface_distance((&a).into(), (&b).into(), 5000);
         let diag = 2f64.sqrt();
         assert!((d.forward - 0.5f64.sqrt() / diag).abs() < 1e-6, "{d:?}");
         assert!(d.backward.abs() < 1e-6, "{d:?}");
@@ -264,15 +243,8 @@ mod tests {
 
     #[test]
     fn sampling_covers_area_and_vertices() {
-        let (p, t) = square(0.0, 2.0);
-        let s = sample(
-            Surface {
-                positions: &p,
-                triangles: &t,
-            },
-            10_000,
-            7,
-        );
+        let square = square(0.0, 2.0);
+        let s = sample((&square).into(), 10_000, 7);
         assert!((10_002..=10_006).contains(&s.len()), "{}", s.len());
         assert!(s.iter().all(|q| q.x >= 0.0
             && q.x <= 2.0

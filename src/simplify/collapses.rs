@@ -201,7 +201,7 @@ impl Collapses {
     /// steps are resolved backwards, so every `kept` is final when read.
     #[must_use]
     pub fn representatives(&self, lod: usize) -> Vec<u32> {
-        let mut rep: Vec<u32> = (0..self.parent.len() as u32).collect();
+        let mut rep = Vec::new();
         self.fill_representatives(lod, &mut rep);
         rep
     }

@@ -100,7 +100,8 @@ impl Ord for Entry {
 /// Why a guard refused a contraction.
 enum Reject {
     Flip,
-    Fin,
+    /// A fin, or the border rule.
+    Topology,
 }
 
 struct Contractor {
@@ -276,13 +277,13 @@ impl Contractor {
             }
         }
         self.vertex_tris[v as usize] = list;
-        if let Some(partners) = self.partners.get(v as usize) {
-            let partners = partners.clone();
-            for w in partners {
-                if !self.removed[w as usize] && self.mark[w as usize] != epoch {
-                    self.mark[w as usize] = epoch;
-                    f(self, w);
-                }
+        // `f` never changes partner lists, so index instead of copying.
+        let partner_count = self.partners.get(v as usize).map_or(0, Vec::len);
+        for i in 0..partner_count {
+            let w = self.partners[v as usize][i];
+            if !self.removed[w as usize] && self.mark[w as usize] != epoch {
+                self.mark[w as usize] = epoch;
+                f(self, w);
             }
         }
     }
@@ -325,38 +326,41 @@ impl Contractor {
             .best(v)
             .map_or((f32::INFINITY, NONE), |(c, w)| (c as f32, w));
         let old = self.queued[v as usize];
-        if new.0 == old.0 && new.1 == old.1 {
-            return;
+        if new.0 != old.0 || new.1 != old.1 {
+            self.queue(v, new.0, new.1);
         }
-        self.queued[v as usize] = new;
+    }
+
+    /// Makes `v → target` at `cost` the vertex's one current entry (no
+    /// entry for [`NONE`]); older entries of `v` go stale.
+    fn queue(&mut self, v: u32, cost: f32, target: u32) {
+        self.queued[v as usize] = (cost, target);
         let version = &mut self.version[v as usize];
         *version = version.wrapping_add(1);
-        if new.1 != NONE {
+        if target != NONE {
             self.heap.push(Entry {
-                cost: new.0,
+                cost,
                 vertex: v,
-                target: new.1,
+                target,
                 stamp: *version,
             });
         }
+    }
+
+    /// Forgets what the guards refused `v`, so that it chooses among all
+    /// its targets again.
+    fn forget_refusals(&mut self, v: u32) {
+        self.blocked_count -= self.blocked[v as usize].len();
+        self.blocked[v as usize].clear();
     }
 
     /// Queues `v → w` if it is cheaper than `v`'s queued contraction.
     fn offer(&mut self, v: u32, w: u32) {
         let cost = self.pair_cost(v, w) as f32;
         let (old_cost, old_target) = self.queued[v as usize];
-        if old_target == w || cost > old_cost || (cost == old_cost && w > old_target) {
-            return;
+        if old_target != w && (cost < old_cost || (cost == old_cost && w < old_target)) {
+            self.queue(v, cost, w);
         }
-        self.queued[v as usize] = (cost, w);
-        let version = &mut self.version[v as usize];
-        *version = version.wrapping_add(1);
-        self.heap.push(Entry {
-            cost,
-            vertex: v,
-            target: w,
-            stamp: *version,
-        });
     }
 
     /// Cost of contracting `v` with `w`: moving `v` onto `w`, or in optimal
@@ -379,17 +383,15 @@ impl Contractor {
     /// meshoptimizer's Hausdorff on `ogre` at 10%), and the mean (not the
     /// area-weighted sum) keeps large flat regions from looking expensive.
     fn cost(&self, removed: u32, kept: u32) -> f64 {
-        let q = &self.quadrics[removed as usize];
-        q.evaluate(self.pos[kept as usize]) / q.weight().max(f64::MIN_POSITIVE)
+        self.quadrics[removed as usize].mean_error(self.pos[kept as usize])
     }
 
     /// The quadric's minimiser, or the best of the endpoints and midpoint.
     fn optimal_point(&self, q: &Quadric, a: u32, b: u32) -> (DVec3, f64) {
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
-        let mean = |p| q.evaluate(p) / q.weight().max(f64::MIN_POSITIVE);
-        let mut best = (pb, mean(pb));
+        let mut best = (pb, q.mean_error(pb));
         for p in [pa, 0.5 * (pa + pb)].into_iter().chain(q.minimizer()) {
-            let cost = mean(p);
+            let cost = q.mean_error(p);
             if cost < best.1 {
                 best = (p, cost);
             }
@@ -437,7 +439,7 @@ impl Contractor {
                     round.candidates += 1;
                     match why {
                         Reject::Flip => round.flip += 1,
-                        Reject::Fin => round.fin += 1,
+                        Reject::Topology => round.topology += 1,
                     }
                     self.blocked[a as usize].push(b);
                     self.blocked_count += 1;
@@ -450,13 +452,12 @@ impl Contractor {
     /// Forgets every refusal and queues every live vertex again.
     fn requeue_all(&mut self) {
         for v in 0..self.pos.len() as u32 {
-            self.blocked[v as usize].clear();
+            self.forget_refusals(v);
             if !self.removed[v as usize] {
                 self.queued[v as usize] = (f32::NAN, NONE);
                 self.refresh(v);
             }
         }
-        self.blocked_count = 0;
     }
 
     /// Where the surviving vertex of `a → b` goes.
@@ -482,12 +483,12 @@ impl Contractor {
         // triangles.)
         let (a_border, ab_triangles) = self.border_and_count(a, b);
         if a_border && ab_triangles == 2 {
-            return Err(Reject::Fin);
+            return Err(Reject::Topology);
         }
         if self.placement == Placement::Optimal {
             let (b_border, _) = self.border_and_count(b, a);
             if b_border && ab_triangles == 2 {
-                return Err(Reject::Fin);
+                return Err(Reject::Topology);
             }
         }
         let epoch = self.next_epoch();
@@ -520,7 +521,7 @@ impl Contractor {
                     .iter()
                     .any(|&w| w != b && self.mark[w as usize] == epoch)
             {
-                return Err(Reject::Fin);
+                return Err(Reject::Topology);
             }
         }
         // Triangles of `a` that survive: no duplicate of a triangle of `b`,
@@ -532,7 +533,7 @@ impl Contractor {
             }
             let others = tri.map(|w| w != a && self.mark[w as usize] == apex);
             if others.iter().filter(|&&x| x).count() == 2 && self.has_triangle_on(b, tri, a) {
-                return Err(Reject::Fin);
+                return Err(Reject::Topology);
             }
             if self.flips(t, a, target) {
                 return Err(Reject::Flip);
@@ -688,14 +689,16 @@ impl Contractor {
             self.partners[survivor as usize] = list;
         }
         self.removed[a as usize] = true;
+        // Entries of removed vertices are skipped by `removed`; the
+        // survivor is refreshed below, which replaces its entry only when
+        // its choice changed (bumping its version here would drop it from
+        // the queue whenever the choice stayed the same).
         for gone in [a, b] {
             if gone != survivor {
-                self.blocked_count -= self.blocked[gone as usize].len();
+                self.forget_refusals(gone);
                 self.blocked[gone as usize] = Vec::new();
             }
         }
-        self.version[a as usize] = self.version[a as usize].wrapping_add(1);
-        self.version[b as usize] = self.version[b as usize].wrapping_add(1);
         self.triangles_now -= dead;
         let rms = f64::from(cost.max(0.0)).sqrt() / self.diagonal;
         self.max_error = self.max_error.max(rms as f32);
@@ -729,8 +732,7 @@ impl Contractor {
                 || queued_target == NONE
                 || !self.blocked[v as usize].is_empty();
             if full {
-                self.blocked_count -= self.blocked[v as usize].len();
-                self.blocked[v as usize].clear();
+                self.forget_refusals(v);
                 self.refresh(v);
             } else {
                 // Only the survivor is new among `v`'s targets, and no other
@@ -761,7 +763,7 @@ impl Contractor {
             vertices,
             candidates_left: round.candidates,
             rejected_flip: round.flip,
-            rejected_fin: round.fin,
+            rejected_topology: round.topology,
         }
     }
 
@@ -782,5 +784,5 @@ impl Contractor {
 struct RoundStats {
     candidates: usize,
     flip: usize,
-    fin: usize,
+    topology: usize,
 }

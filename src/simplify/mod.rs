@@ -82,9 +82,10 @@ pub struct Stop {
     pub candidates_left: usize,
     /// Of those, rejected because a triangle normal would flip.
     pub rejected_flip: usize,
-    /// Of those, rejected because a non-manifold fin (an edge with extra
-    /// triangles, or two triangles on the same three vertices) would appear.
-    pub rejected_fin: usize,
+    /// Of those, rejected by a topology rule: a non-manifold fin (an edge
+    /// with extra triangles, or two triangles on the same three vertices)
+    /// would appear, or a border vertex would leave its border.
+    pub rejected_topology: usize,
 }
 
 impl std::fmt::Display for Stop {
@@ -98,13 +99,13 @@ impl std::fmt::Display for Stop {
             StopReason::NoValidPair => write!(
                 f,
                 "no valid pair left at LoD {} ({} triangles, {} vertices): \
-                 {} candidates, {} would flip a normal, {} would make a fin",
+                 {} candidates, {} would flip a normal, {} break a topology rule",
                 self.lod,
                 self.triangles,
                 self.vertices,
                 self.candidates_left,
                 self.rejected_flip,
-                self.rejected_fin
+                self.rejected_topology
             ),
         }
     }

@@ -100,12 +100,13 @@ impl Quadric {
         self.weight
     }
 
-    /// Root-mean-square plane distance for a cost from [`Quadric::evaluate`]:
-    /// `sqrt(cost / weight)`, in model units; 0 for an empty quadric.
+    /// Mean squared plane distance at `p`: [`Quadric::evaluate`] divided by
+    /// the weight (0 for an empty quadric). The contraction cost.
     #[must_use]
-    pub fn rms(&self, cost: f64) -> f64 {
+    #[inline]
+    pub fn mean_error(&self, p: DVec3) -> f64 {
         if self.weight > 0.0 {
-            (cost / self.weight).sqrt()
+            self.evaluate(p) / self.weight
         } else {
             0.0
         }
@@ -163,7 +164,7 @@ mod tests {
         let q = Quadric::plane(DVec3::Z, DVec3::new(0.0, 0.0, 1.0), 2.0);
         assert!((q.evaluate(DVec3::new(5.0, -3.0, 4.0)) - 2.0 * 9.0).abs() < 1e-12);
         assert_eq!(q.evaluate(DVec3::new(7.0, 1.0, 1.0)), 0.0);
-        assert!((q.rms(18.0) - 3.0).abs() < 1e-12);
+        assert!((q.mean_error(DVec3::new(5.0, -3.0, 4.0)) - 9.0).abs() < 1e-12);
     }
 
     #[test]
