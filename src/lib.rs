@@ -25,11 +25,13 @@
 pub mod distance;
 pub mod error;
 pub mod mesh;
+pub mod model;
 pub mod peers;
 pub mod simplify;
 pub mod strip;
 
 pub use error::{Error, Place, Result};
 pub use mesh::Mesh;
+pub use model::{Extractor, MtsModel};
 pub use simplify::{simplify, Collapses, SimplifyOptions};
 pub use strip::{stripify, StripifyOptions, Strips};

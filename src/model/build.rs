@@ -1,0 +1,695 @@
+//! Construction of the MTS model: the contraction sequence replayed strip by
+//! strip (section 3.1.1 of the MTS paper, "Construction example").
+//!
+//! # The strip at a LoD
+//!
+//! Let `s` be a strip's run and `s'` the same run with every vertex replaced
+//! by its representative at LoD `k`. The windows of `s'` are exactly the
+//! strip's triangles at LoD `k`, each at its original position, so with its
+//! original parity and orientation; the windows that repeat a vertex are the
+//! dropped triangles (and the original swaps). Triangles only ever die, so
+//! the set of *live* (non-degenerate) windows only shrinks.
+//!
+//! The strip at LoD `k` is written as a subsequence of the *positions* of
+//! `s'` with run breaks, chosen by one local rule over consecutive live
+//! windows `a < b`:
+//! - **contiguous** when the filler `b − a − 3` (positions between `a`'s last
+//!   vertex and `b`'s first) costs no more than a break: every window in
+//!   between repeats a vertex, so it draws nothing, and parities stay those
+//!   of `s`. A lone dead window between two live ones is exactly a swap
+//!   ("a lost turn becomes a swap");
+//! - otherwise a **break** (a restart, the paper's −2): the next run starts
+//!   at `b` when `b` is even, or at `b − 1` when it is odd, so that `b` keeps
+//!   its parity (window `b − 1` is dead, so it draws nothing). A break costs
+//!   one restart plus that parity vertex.
+//!
+//! The strip starts like a run after a break and ends at the last live
+//! window (the paper's −3). Every emitted window is a window of `s'`, or
+//! spans a gap of dead windows and repeats a vertex; so the strip draws
+//! exactly its triangles at LoD `k`, with their orientation.
+//!
+//! **Monotone**: as windows die the gaps only grow, so a contiguous pair can
+//! become a break but never the reverse, and a position once left out is
+//! never needed again. Hence the length of the strip never grows with the
+//! LoD (the extractor's per-strip slot is the LoD-0 length), and a position
+//! left out can be forgotten.
+//!
+//! # The graph
+//!
+//! A node is one position with its current vertex: when a contraction
+//! replaces a position's vertex, the position gets a new node. At LoD `k`
+//! each node in the strip has exactly one outgoing arc (to the next emitted
+//! position's node, with or without a break, or to the end). When a
+//! contraction changes that arc, the old arc is closed with label `k − 1`
+//! and a new one opens; an arc still open at the end gets `max_lod`. The
+//! beginnings list is kept the same way.
+//!
+//! # Cost
+//!
+//! Every vertex keeps the list of strip positions it occupies. A
+//! contraction visits the positions of the removed vertex (dropping those
+//! left out), then re-encodes only the span between the nearest unchanged
+//! live windows on either side, found through union-find links over dead
+//! windows. So construction costs O(positions + total strip changes), not
+//! strips × LoDs.
+
+use super::{MtsModel, END, NODE_MASK, RESTART};
+use crate::mesh::Mesh;
+use crate::simplify::Collapses;
+use crate::strip::{stripify, StripifyOptions, Strips};
+
+/// "None" in the construction's index arrays.
+const NONE: u32 = u32::MAX;
+
+/// How the model is built.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BuildOptions {
+    /// A new band of strips, stripified afresh from the mesh of that LoD,
+    /// starts when the current band's strips would send more than
+    /// `1 + band_slack` times the indices per triangle they sent at the
+    /// band's first LoD. `f64::INFINITY` keeps one band: the paper's model.
+    pub band_slack: f64,
+    /// The stripifier used for every band after the first. The default is
+    /// the local pass alone with one swap penalty: on the bunny it builds
+    /// the 69 bands in 232 ms instead of 389 ms, for a worst strip-quality
+    /// ratio of 1.116 instead of 1.105 (ARCHITECTURE.md, "MTS model").
+    pub stripify: StripifyOptions,
+}
+
+impl Default for BuildOptions {
+    fn default() -> BuildOptions {
+        BuildOptions {
+            band_slack: DEFAULT_BAND_SLACK,
+            stripify: StripifyOptions {
+                patches: false,
+                swap_penalties: [Some(0.5), None],
+                ..StripifyOptions::default()
+            },
+        }
+    }
+}
+
+/// See [`BuildOptions::band_slack`] and `ARCHITECTURE.md` ("MTS model").
+pub const DEFAULT_BAND_SLACK: f64 = 0.10;
+
+/// Builds the MTS model of `mesh` from its strips (those of LoD 0) and its
+/// contraction sequence; later bands are stripified from the mesh at their
+/// first LoD with `options.stripify`.
+///
+/// # Panics
+/// If `strips` or `collapses` were not made for `mesh` (different vertex
+/// counts), or the strips do not index `mesh`'s vertices.
+#[must_use]
+pub fn build(mesh: &Mesh, strips: &Strips, collapses: &Collapses, options: &BuildOptions) -> MtsModel {
+    assert_eq!(strips.vertex_count() as usize, mesh.vertex_count(), "strips of another mesh");
+    assert_eq!(collapses.vertex_count(), mesh.vertex_count(), "collapses of another mesh");
+    let max_lod = collapses.max_lod() as u32;
+    let counts = collapses.triangle_counts();
+    let mut positions = mesh.positions.clone();
+    positions.extend_from_slice(collapses.appended());
+    let mut model = MtsModel {
+        positions,
+        triangle_counts: counts.to_vec(),
+        strip_nodes: vec![0],
+        strip_begins: vec![0],
+        band_strips: vec![0],
+        ..MtsModel::default()
+    };
+    let vertex_total = model.positions.len();
+    let optimal = collapses.is_optimal_placement();
+    let mut moved = Vec::with_capacity(2);
+    let mut first = 0u32;
+    loop {
+        let band_strips;
+        let strips = if first == 0 {
+            strips
+        } else {
+            let at = Mesh {
+                positions: model.positions.clone(),
+                triangles: collapses.triangles_at(mesh, first as usize),
+            };
+            band_strips = stripify(&at, &options.stripify);
+            &band_strips
+        };
+        let mut builder = Builder::new(strips, vertex_total, first);
+        // Indices the band may send per triangle before the next band starts.
+        let limit = (1.0 + options.band_slack) * builder.indices() as f64
+            / f64::from(counts[first as usize].max(1));
+        let mut last = max_lod;
+        for k in first + 1..=max_lod {
+            let i = k as usize - 1;
+            let step = &collapses.steps()[i];
+            moved.clear();
+            moved.push(step.removed);
+            if optimal {
+                moved.push(step.kept);
+            }
+            builder.contract(k, &moved, collapses.target(i));
+            if builder.indices() as f64 > limit * f64::from(counts[k as usize]) {
+                last = k - 1;
+                break;
+            }
+        }
+        model.band_lod.push(first);
+        builder.finish_into(&mut model, first, last, max_lod);
+        model.band_strips.push(model.strip_nodes.len() as u32 - 1);
+        if last == max_lod {
+            break;
+        }
+        first = last + 1;
+    }
+    debug_assert_eq!(model.check(), Ok(()));
+    model
+}
+
+/// A closed (or finally closed) arc: `node → target`, valid up to `res`.
+#[derive(Clone, Copy)]
+struct ArcRecord {
+    node: u32,
+    target: u32,
+    res: u32,
+}
+
+struct Builder {
+    /// Position → strip, and each strip's first position (`strip_base[s]`,
+    /// one more entry than strips).
+    pos_strip: Vec<u32>,
+    strip_base: Vec<u32>,
+    /// Current vertex at each position (`s'`).
+    cur: Vec<u32>,
+    /// Whether the position is emitted at the current LoD.
+    included: Vec<bool>,
+    /// For an emitted position: the next emitted one (with [`RESTART`] for a
+    /// break) or [`END`].
+    succ: Vec<u32>,
+    /// Union-find links over windows (a window is named by its first
+    /// position): a live window links to itself, a dead one to its left
+    /// (right) neighbour, [`NONE`] past the strip's first (last) window.
+    prev_link: Vec<u32>,
+    next_link: Vec<u32>,
+    live: Vec<bool>,
+    /// Current node of an emitted position ([`NONE`] when its vertex changed
+    /// since the node was made).
+    node_of: Vec<u32>,
+    /// Per vertex, the positions it occupies: singly linked lists with tails.
+    occ_head: Vec<u32>,
+    occ_tail: Vec<u32>,
+    occ_next: Vec<u32>,
+    /// Nodes: position and vertex, and the arc currently open (target or
+    /// [`NONE`]).
+    node_pos: Vec<u32>,
+    node_vertex: Vec<u32>,
+    node_open: Vec<u32>,
+    /// LoD from which the open arc holds.
+    node_since: Vec<u32>,
+    closed: Vec<ArcRecord>,
+    /// Per strip, the open beginning (first node or [`END`]) and the closed
+    /// ones as (strip, node, res).
+    begin_open: Vec<u32>,
+    begins_closed: Vec<(u32, u32, u32)>,
+    /// Scratch: changed positions, the span's old and new emitted positions.
+    touched: Vec<u32>,
+    mark: Vec<u32>,
+    stamp: u32,
+    old_span: Vec<u32>,
+    new_span: Vec<(u32, bool)>,
+    /// Set once the strips' starting state is encoded.
+    replaying: bool,
+    /// LoD from which each strip's open beginning holds.
+    begin_since: Vec<u32>,
+    /// Emitted positions, run breaks and non-empty strips now: the indices
+    /// a compact restart-encoded buffer holds (see [`Builder::indices`]).
+    emitted: usize,
+    breaks: usize,
+    non_empty: usize,
+}
+
+impl Builder {
+    /// A builder for strips that start at LoD `first` (their vertices are
+    /// already those of that LoD).
+    fn new(strips: &Strips, vertex_count: usize, first: u32) -> Builder {
+        let total: usize = strips.runs().map(<[u32]>::len).sum();
+        assert!(total < NODE_MASK as usize, "strips too long for 31-bit node indices");
+        let mut b = Builder {
+            pos_strip: Vec::with_capacity(total),
+            strip_base: Vec::with_capacity(strips.run_count() + 1),
+            cur: Vec::with_capacity(total),
+            included: vec![true; total],
+            succ: Vec::with_capacity(total),
+            prev_link: Vec::with_capacity(total),
+            next_link: Vec::with_capacity(total),
+            live: Vec::with_capacity(total),
+            node_of: Vec::with_capacity(total),
+            occ_head: vec![NONE; vertex_count],
+            occ_tail: vec![NONE; vertex_count],
+            occ_next: vec![NONE; total],
+            node_pos: Vec::with_capacity(total),
+            node_vertex: Vec::with_capacity(total),
+            node_open: Vec::with_capacity(total),
+            node_since: Vec::with_capacity(total),
+            closed: Vec::new(),
+            begin_open: Vec::with_capacity(strips.run_count()),
+            begins_closed: Vec::new(),
+            touched: Vec::new(),
+            mark: vec![0; total],
+            stamp: 0,
+            old_span: Vec::new(),
+            new_span: Vec::new(),
+            replaying: false,
+            begin_since: Vec::with_capacity(strips.run_count()),
+            emitted: 0,
+            breaks: 0,
+            non_empty: 0,
+        };
+        for (s, run) in strips.runs().enumerate() {
+            let base = b.cur.len() as u32;
+            b.strip_base.push(base);
+            let len = run.len() as u32;
+            for (p, &v) in run.iter().enumerate() {
+                let gp = base + p as u32;
+                b.pos_strip.push(s as u32);
+                b.cur.push(v);
+                let is_window = (p as u32) + 2 < len;
+                let live = is_window && !crate::mesh::is_degenerate([v, run[p + 1], run[p + 2]]);
+                b.live.push(live);
+                b.push_occurrence(v, gp);
+            }
+            for p in 0..len {
+                let gp = base + p;
+                let live = b.live[gp as usize];
+                b.prev_link.push(if live { gp } else if p == 0 { NONE } else { gp - 1 });
+                b.next_link
+                    .push(if live { gp } else if p + 3 >= len { NONE } else { gp + 1 });
+            }
+            // LoD 0: the rule applied to the whole run.
+            b.included[base as usize..(base + len) as usize].fill(false);
+            b.node_of.extend(std::iter::repeat_n(NONE, len as usize));
+            b.succ.extend(std::iter::repeat_n(END, len as usize));
+            let live = b.encode_span(s, None, None);
+            let first_node = b.commit_new_span(None, None, first);
+            debug_assert_eq!(live.is_some(), first_node != END);
+            b.begin_open.push(first_node);
+            b.begin_since.push(first);
+            b.non_empty += usize::from(first_node != END);
+        }
+        b.strip_base.push(b.cur.len() as u32);
+        b.replaying = true;
+        b
+    }
+
+    /// Indices of the band at the current LoD, as the extractor's compact
+    /// buffer counts them: positions, run breaks, one restart between
+    /// non-empty strips.
+    fn indices(&self) -> usize {
+        self.emitted + self.breaks + self.non_empty.saturating_sub(1)
+    }
+
+    fn push_occurrence(&mut self, v: u32, gp: u32) {
+        let v = v as usize;
+        if self.occ_head[v] == NONE {
+            self.occ_head[v] = gp;
+        } else {
+            self.occ_next[self.occ_tail[v] as usize] = gp;
+        }
+        self.occ_tail[v] = gp;
+        self.occ_next[gp as usize] = NONE;
+    }
+
+    /// Last live window at or before `w` (in `w`'s strip), with path halving.
+    fn find_prev(&mut self, mut w: u32) -> Option<u32> {
+        loop {
+            let l = self.prev_link[w as usize];
+            if l == w {
+                return Some(w);
+            }
+            if l == NONE {
+                return None;
+            }
+            let ll = self.prev_link[l as usize];
+            self.prev_link[w as usize] = ll;
+            if ll == NONE {
+                return None;
+            }
+            w = ll;
+        }
+    }
+
+    /// First live window at or after `w` (in `w`'s strip).
+    fn find_next(&mut self, mut w: u32) -> Option<u32> {
+        loop {
+            let l = self.next_link[w as usize];
+            if l == w {
+                return Some(w);
+            }
+            if l == NONE {
+                return None;
+            }
+            let ll = self.next_link[l as usize];
+            self.next_link[w as usize] = ll;
+            if ll == NONE {
+                return None;
+            }
+            w = ll;
+        }
+    }
+
+    fn strip_range(&self, s: usize) -> (u32, u32) {
+        (self.strip_base[s], self.strip_base[s + 1])
+    }
+
+    /// Computes into `new_span` the emitted positions after live window
+    /// `a_prev` (or from the strip's start) up to and including live window
+    /// `b_next`'s last position (or to the strip's end), each with "break
+    /// before". Returns the first live window emitted, if any.
+    fn encode_span(&mut self, s: usize, a_prev: Option<u32>, b_next: Option<u32>) -> Option<u32> {
+        let base = self.strip_base[s];
+        let end = self.strip_base.get(s + 1).copied().unwrap_or(self.cur.len() as u32);
+        self.new_span.clear();
+        let mut prev = a_prev;
+        let mut last_emitted = a_prev.map(|a| a + 2);
+        let mut from = match a_prev {
+            Some(a) => a + 1,
+            None => base,
+        };
+        let mut first_live = None;
+        while from + 2 < end {
+            let Some(b) = self.find_next(from) else { break };
+            if b_next.is_some_and(|bn| b > bn) {
+                break;
+            }
+            first_live.get_or_insert(b);
+            let odd = (b - base) & 1;
+            let contiguous = match prev {
+                None => false,
+                Some(a) => i64::from(b) - i64::from(a) - 3 <= 1 + i64::from(odd),
+            };
+            let start = if contiguous {
+                last_emitted.map_or(b, |l| l + 1)
+            } else {
+                b - odd
+            };
+            for (i, p) in (start..=b + 2).enumerate() {
+                if last_emitted.is_some_and(|l| p <= l) {
+                    continue;
+                }
+                self.new_span.push((p, i == 0 && !contiguous && prev.is_some()));
+            }
+            last_emitted = Some(b + 2);
+            prev = Some(b);
+            if b_next == Some(b) {
+                break;
+            }
+            from = b + 1;
+        }
+        first_live
+    }
+
+    /// The node of emitted position `gp`, made when its vertex changed.
+    fn node(&mut self, gp: u32) -> u32 {
+        let n = self.node_of[gp as usize];
+        if n != NONE {
+            return n;
+        }
+        let n = self.node_pos.len() as u32;
+        self.node_pos.push(gp);
+        self.node_vertex.push(self.cur[gp as usize]);
+        self.node_open.push(NONE);
+        self.node_since.push(0);
+        self.node_of[gp as usize] = n;
+        n
+    }
+
+    /// Closes node `n`'s open arc (if any) with label `res`; an arc that
+    /// never held (opened after `res`) leaves no record.
+    fn close(&mut self, n: u32, res: u32) {
+        let t = self.node_open[n as usize];
+        if t != NONE {
+            if self.node_since[n as usize] <= res {
+                self.closed.push(ArcRecord { node: n, target: t, res });
+            }
+            self.node_open[n as usize] = NONE;
+        }
+    }
+
+    /// Sets node `n`'s arc to `target` from LoD `lod` on.
+    fn set_arc(&mut self, n: u32, target: u32, lod: u32) {
+        let open = self.node_open[n as usize];
+        if open == target {
+            return;
+        }
+        if open != NONE && lod > 0 {
+            self.close(n, lod - 1);
+        }
+        self.node_open[n as usize] = target;
+        self.node_since[n as usize] = lod;
+    }
+
+    /// Applies `new_span` after `a_prev` (whose last position keeps its
+    /// node): marks positions emitted, makes nodes and arcs, links `succ`.
+    /// `b_next` is the unchanged live window closing the span; without it
+    /// the span ends the strip. Returns the first node of the span (or
+    /// [`END`] if empty).
+    fn commit_new_span(&mut self, a_prev: Option<u32>, b_next: Option<u32>, lod: u32) -> u32 {
+        let span = std::mem::take(&mut self.new_span);
+        for &(p, _) in &span {
+            debug_assert!(!self.replaying || self.included[p as usize], "position {p} came back");
+            self.emitted += usize::from(!self.included[p as usize]);
+            self.included[p as usize] = true;
+            self.mark[p as usize] = self.stamp;
+        }
+        let mut from = a_prev.map(|a| a + 2);
+        for &(p, brk) in &span {
+            let target = self.node(p) | if brk { RESTART } else { 0 };
+            if let Some(f) = from {
+                let fnode = self.node(f);
+                self.set_arc(fnode, target, lod);
+                self.set_succ(f, p | if brk { RESTART } else { 0 });
+            }
+            from = Some(p);
+        }
+        if b_next.is_none() {
+            if let Some(f) = from {
+                let fnode = self.node(f);
+                self.set_arc(fnode, END, lod);
+                self.set_succ(f, END);
+            }
+        }
+        let first = span.first().map_or(END, |&(p, _)| self.node_of[p as usize]);
+        self.new_span = span;
+        first
+    }
+
+    /// Sets the successor of emitted position `f`, counting run breaks.
+    fn set_succ(&mut self, f: u32, succ: u32) {
+        let old = self.succ[f as usize];
+        self.breaks -= usize::from(old != END && old & RESTART != 0);
+        self.breaks += usize::from(succ != END && succ & RESTART != 0);
+        self.succ[f as usize] = succ;
+    }
+
+    /// Replays one contraction: the positions of `moved` vertices now hold
+    /// `target`, at LoD `lod`.
+    fn contract(&mut self, lod: u32, moved: &[u32], target: u32) {
+        self.touched.clear();
+        for &v in moved {
+            let mut gp = self.occ_head[v as usize];
+            self.occ_head[v as usize] = NONE;
+            self.occ_tail[v as usize] = NONE;
+            while gp != NONE {
+                let next = self.occ_next[gp as usize];
+                if self.included[gp as usize] {
+                    self.cur[gp as usize] = target;
+                    let n = self.node_of[gp as usize];
+                    if n != NONE {
+                        self.close(n, lod - 1);
+                        self.node_of[gp as usize] = NONE;
+                    }
+                    self.touched.push(gp);
+                    self.push_occurrence(target, gp);
+                }
+                gp = next;
+            }
+        }
+        if self.touched.is_empty() {
+            return;
+        }
+        self.touched.sort_unstable();
+        // Liveness of every window holding a changed position.
+        for i in 0..self.touched.len() {
+            let gp = self.touched[i];
+            let s = self.pos_strip[gp as usize] as usize;
+            let (base, end) = self.strip_range(s);
+            for w in gp.saturating_sub(2).max(base)..=gp {
+                if w + 2 >= end || !self.live[w as usize] {
+                    continue;
+                }
+                let (x, y, z) = (self.cur[w as usize], self.cur[w as usize + 1], self.cur[w as usize + 2]);
+                if x == y || y == z || x == z {
+                    self.live[w as usize] = false;
+                    self.prev_link[w as usize] = if w == base { NONE } else { w - 1 };
+                    self.next_link[w as usize] = if w + 3 >= end { NONE } else { w + 1 };
+                }
+            }
+        }
+        // Spans: runs of changed positions whose closing live windows do
+        // not touch the next changed position.
+        let touched = std::mem::take(&mut self.touched);
+        let mut i = 0;
+        while i < touched.len() {
+            let s = self.pos_strip[touched[i] as usize] as usize;
+            let (base, end) = self.strip_range(s);
+            let lo = touched[i];
+            let mut j = i;
+            let b_next = loop {
+                let hi = touched[j];
+                let b = if hi + 1 + 2 < end { self.find_next(hi + 1) } else { None };
+                let joins = j + 1 < touched.len()
+                    && self.pos_strip[touched[j + 1] as usize] as usize == s
+                    && b.is_none_or(|b| b + 2 >= touched[j + 1]);
+                if joins {
+                    j += 1;
+                } else {
+                    break b;
+                }
+            };
+            let a_prev = if lo >= base + 3 { self.find_prev(lo - 3) } else { None };
+            self.respan(s, a_prev, b_next, lod);
+            i = j + 1;
+        }
+        self.touched = touched;
+    }
+
+    /// Re-encodes strip `s` between unchanged live windows `a_prev` and
+    /// `b_next` (either may be missing: the strip's start or end).
+    fn respan(&mut self, s: usize, a_prev: Option<u32>, b_next: Option<u32>, lod: u32) {
+        // The old emitted positions after a_prev's last one, up to b_next.
+        self.old_span.clear();
+        let mut p = match a_prev {
+            Some(a) => self.succ[(a + 2) as usize],
+            None => {
+                let first = self.begin_open[s];
+                if first == END {
+                    END
+                } else {
+                    self.node_pos[first as usize]
+                }
+            }
+        };
+        while p != END {
+            let q = p & NODE_MASK;
+            if b_next.is_some_and(|b| q >= b) {
+                break;
+            }
+            self.old_span.push(q);
+            p = self.succ[q as usize];
+        }
+        self.stamp += 1;
+        self.encode_span(s, a_prev, b_next);
+        let first = self.commit_new_span(a_prev, b_next, lod);
+        // Positions left out: their nodes close, they are forgotten.
+        for i in 0..self.old_span.len() {
+            let q = self.old_span[i];
+            if self.mark[q as usize] != self.stamp {
+                self.included[q as usize] = false;
+                let succ = self.succ[q as usize];
+                self.emitted -= 1;
+                self.breaks -= usize::from(succ != END && succ & RESTART != 0);
+                let n = self.node_of[q as usize];
+                if n != NONE {
+                    self.close(n, lod - 1);
+                    self.node_of[q as usize] = NONE;
+                }
+            }
+        }
+        if a_prev.is_none() {
+            let old = self.begin_open[s];
+            if old != first {
+                if self.begin_since[s] < lod {
+                    self.begins_closed.push((s as u32, old, lod - 1));
+                }
+                self.begin_open[s] = first;
+                self.begin_since[s] = lod;
+                self.non_empty = self.non_empty + usize::from(first != END) - usize::from(old != END);
+            }
+        }
+    }
+
+    /// Closes the band (its strips hold LoDs `first..=last`) and appends its
+    /// strips to `model`, nodes numbered in strip order.
+    fn finish_into(mut self, model: &mut MtsModel, first: u32, last: u32, max_lod: u32) {
+        for n in 0..self.node_open.len() as u32 {
+            self.close(n, last);
+        }
+        let node_base = model.node_vertex.len() as u32;
+        let node_count = self.node_pos.len();
+        let mut order: Vec<u32> = (0..node_count as u32).collect();
+        order.sort_unstable_by_key(|&n| (self.node_pos[n as usize], n));
+        let mut new_id = vec![0u32; node_count];
+        for (i, &n) in order.iter().enumerate() {
+            new_id[n as usize] = node_base + i as u32;
+        }
+        let remap = |t: u32| if t == END { END } else { new_id[(t & NODE_MASK) as usize] | (t & RESTART) };
+        let strips = self.strip_base.len() - 1;
+        let mut per_strip = vec![0u32; strips];
+        for &n in &order {
+            per_strip[self.pos_strip[self.node_pos[n as usize] as usize] as usize] += 1;
+        }
+        for c in per_strip {
+            let last_offset = *model.strip_nodes.last().unwrap_or(&0);
+            model.strip_nodes.push(last_offset + c);
+        }
+        // Arcs grouped by node; the records of one node were closed in LoD
+        // order, so a stable grouping keeps their labels increasing.
+        let mut count = vec![0u32; node_count + 1];
+        for r in &self.closed {
+            count[(new_id[r.node as usize] - node_base) as usize + 1] += 1;
+        }
+        prefix_sum(&mut count);
+        let arc_base = model.arc_target.len() as u32;
+        let mut fill = count.clone();
+        let arcs = self.closed.len();
+        model.arc_target.resize(arc_base as usize + arcs, 0);
+        model.arc_res.resize(arc_base as usize + arcs, 0);
+        for r in &self.closed {
+            let n = (new_id[r.node as usize] - node_base) as usize;
+            let a = (arc_base + fill[n]) as usize;
+            fill[n] += 1;
+            model.arc_target[a] = remap(r.target);
+            model.arc_res[a] = r.res;
+        }
+        model.node_arcs.pop();
+        model.node_arcs.extend(count.iter().map(|&c| arc_base + c));
+        model
+            .node_vertex
+            .extend(order.iter().map(|&n| self.node_vertex[n as usize]));
+        // Beginnings: empty before the band, the recorded ones, the open
+        // one, empty after the band.
+        for s in 0..strips {
+            if self.begin_since[s] <= last {
+                self.begins_closed.push((s as u32, self.begin_open[s], last));
+            }
+            if first > 0 {
+                self.begins_closed.push((s as u32, END, first - 1));
+            }
+            if last < max_lod {
+                self.begins_closed.push((s as u32, END, max_lod));
+            }
+        }
+        self.begins_closed.sort_by_key(|&(s, _, res)| (s, res));
+        for s in 0..strips {
+            let start = self.begins_closed.partition_point(|&(t, _, _)| (t as usize) < s);
+            let end = self.begins_closed.partition_point(|&(t, _, _)| (t as usize) <= s);
+            for &(_, n, res) in &self.begins_closed[start..end] {
+                model.begin_node.push(remap(n));
+                model.begin_res.push(res);
+            }
+            model.strip_begins.push(model.begin_node.len() as u32);
+        }
+    }
+}
+
+fn prefix_sum(v: &mut [u32]) {
+    for i in 1..v.len() {
+        v[i] += v[i - 1];
+    }
+}

@@ -1,0 +1,358 @@
+//! Level-of-detail recovery (section 3.2 of the MTS paper) with the
+//! coherence cache of section 4.
+//!
+//! The output is one `u32` index buffer laid out in per-strip *slots*: strip
+//! `s` owns `slot_start[s]..slot_start[s + 1]`, sized for its LoD-0 sequence
+//! (the longest it ever gets, see `build.rs`, "Monotone") plus one restart
+//! that separates it from the next slot. What a strip does not use is
+//! filled with restart values, which draw nothing. A new LoD re-walks only
+//! the strips whose validity interval `[minRes, maxRes]` excludes it, and
+//! reports the slots it rewrote as dirty ranges, so a renderer uploads only
+//! those. [`Extractor::write_compact`] gives the same strips without the
+//! padding (what "indices sent" counts).
+
+use super::{MtsModel, END, NODE_MASK, RESTART};
+use crate::strip::encode::RESTART_U32;
+use std::ops::Range;
+
+/// What one LoD change did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Update {
+    /// The LoD now extracted.
+    pub lod: usize,
+    /// Strips walked again.
+    pub strips_walked: usize,
+    /// Dirty ranges reported (see [`Extractor::dirty_ranges`]).
+    pub dirty_ranges: usize,
+}
+
+/// Extracts any LoD of a model into a slot-laid index buffer, re-walking
+/// only what changed since the last call.
+///
+/// Allocation happens in [`Extractor::new`] only: every buffer is sized for
+/// the worst case there.
+#[derive(Debug, Clone)]
+pub struct Extractor<'m> {
+    model: &'m MtsModel,
+    buffer: Vec<u32>,
+    slot_start: Vec<u32>,
+    /// Indices each strip uses now (its run breaks included).
+    len: Vec<u32>,
+    /// Validity interval of each strip's current sequence (inclusive).
+    valid_from: Vec<u32>,
+    valid_to: Vec<u32>,
+    lod: Option<usize>,
+    /// The band whose strips the buffer holds.
+    band: Option<usize>,
+    dirty: Vec<Range<usize>>,
+    /// Sum of `len`, and strips with `len > 0`.
+    used: usize,
+    non_empty: usize,
+    /// Walks cut at their slot's end (only a corrupt model can cause one).
+    overflows: usize,
+}
+
+/// Result of walking one strip.
+struct Walk {
+    len: u32,
+    from: u32,
+    to: u32,
+    overflow: bool,
+}
+
+impl<'m> Extractor<'m> {
+    /// An extractor for `model`, with nothing extracted yet (the buffer is
+    /// all restarts). Cost: one walk of every strip at LoD 0 to size the
+    /// slots.
+    #[must_use]
+    pub fn new(model: &'m MtsModel) -> Extractor<'m> {
+        let strips = model.strip_count();
+        let mut slot_start = Vec::with_capacity(strips + 1);
+        slot_start.push(0u32);
+        // The LoD-0 walk bounds every later one; a node count bound keeps
+        // the sizing walk itself in range on a corrupt model.
+        let mut scratch = Vec::new();
+        for b in 0..model.band_count() {
+            let birth = model.band_first_lod(b) as u32;
+            for s in model.band_strips(b) {
+                let nodes = model.nodes_of(s).len();
+                scratch.resize(2 * nodes + 1, 0);
+                let w = walk(model, s, birth, &mut scratch);
+                let last = *slot_start.last().unwrap_or(&0);
+                slot_start.push(last + w.len + 1);
+            }
+        }
+        let total = *slot_start.last().unwrap_or(&0) as usize;
+        Extractor {
+            model,
+            buffer: vec![RESTART_U32; total],
+            slot_start,
+            len: vec![0; strips],
+            valid_from: vec![1; strips],
+            valid_to: vec![0; strips],
+            lod: None,
+            band: None,
+            dirty: Vec::with_capacity(strips + 1),
+            used: 0,
+            non_empty: 0,
+            overflows: 0,
+        }
+    }
+
+    /// The model extracted from.
+    #[must_use]
+    pub fn model(&self) -> &'m MtsModel {
+        self.model
+    }
+
+    /// Extracts `lod` (clamped to `max_lod`), re-walking only the strips
+    /// whose validity interval excludes it. The output is identical to
+    /// [`Extractor::set_lod_from_scratch`].
+    pub fn set_lod(&mut self, lod: usize) -> Update {
+        self.update(lod, true)
+    }
+
+    /// Extracts `lod` walking every strip (no coherence): the reference the
+    /// coherent path is measured and tested against.
+    pub fn set_lod_from_scratch(&mut self, lod: usize) -> Update {
+        self.update(lod, false)
+    }
+
+    /// [`Extractor::set_lod`] at the finest LoD with at most `budget`
+    /// triangles.
+    pub fn set_triangles(&mut self, budget: usize) -> Update {
+        self.set_lod(self.model.lod_for_triangles(budget))
+    }
+
+    /// [`Extractor::set_lod`] at `ratio` of the full triangle count.
+    pub fn set_ratio(&mut self, ratio: f64) -> Update {
+        self.set_lod(self.model.lod_for_ratio(ratio))
+    }
+
+    fn update(&mut self, lod: usize, coherent: bool) -> Update {
+        let model = self.model;
+        let lod = lod.min(model.max_lod());
+        let band = model.band_of(lod);
+        self.dirty.clear();
+        let mut walked = 0;
+        let left = self.band.filter(|&b| b != band);
+        if coherent {
+            // Strips of the band left behind are empty at `lod`: clear their
+            // slots, and walk them again when their band comes back.
+            if let Some(old) = left {
+                for s in model.band_strips(old) {
+                    self.clear(s);
+                }
+            }
+            for s in model.band_strips(band) {
+                walked += usize::from(self.refresh(s, lod as u32, true));
+            }
+        } else {
+            // From scratch: every strip of the band walked, every other
+            // strip emptied (the band table says they draw nothing here).
+            let strips = model.band_strips(band);
+            for s in 0..self.len.len() {
+                if strips.contains(&s) {
+                    walked += usize::from(self.refresh(s, lod as u32, false));
+                } else if self.len[s] > 0 {
+                    self.clear(s);
+                }
+            }
+        }
+        if left.is_some_and(|old| old > band) {
+            // Ranges were pushed band by band: restore ascending order.
+            self.dirty.sort_unstable_by_key(|r| r.start);
+        }
+        self.lod = Some(lod);
+        self.band = Some(band);
+        Update {
+            lod,
+            strips_walked: walked,
+            dirty_ranges: self.dirty.len(),
+        }
+    }
+
+    /// Walks strip `s` at `lod` into its slot unless (when `coherent`) its
+    /// validity interval holds `lod`. Returns whether it walked.
+    fn refresh(&mut self, s: usize, lod: u32, coherent: bool) -> bool {
+        if coherent && self.valid_from[s] <= lod && lod <= self.valid_to[s] {
+            return false;
+        }
+        let slot = self.slot_start[s] as usize..self.slot_start[s + 1] as usize - 1;
+        let w = walk(self.model, s, lod, &mut self.buffer[slot.clone()]);
+        self.overflows += usize::from(w.overflow);
+        self.set_len(s, w.len as usize);
+        self.valid_from[s] = w.from;
+        self.valid_to[s] = w.to;
+        true
+    }
+
+    /// Empties strip `s`'s slot and marks it for a walk.
+    fn clear(&mut self, s: usize) {
+        self.set_len(s, 0);
+        self.valid_from[s] = 1;
+        self.valid_to[s] = 0;
+    }
+
+    /// Records that strip `s` now uses `new` indices of its slot: pads what
+    /// it no longer uses and reports the slot's touched part as dirty.
+    fn set_len(&mut self, s: usize, new: usize) {
+        let start = self.slot_start[s] as usize;
+        let old = self.len[s] as usize;
+        if old > new {
+            self.buffer[start + new..start + old].fill(RESTART_U32);
+        }
+        self.used = self.used + new - old;
+        self.non_empty = self.non_empty + usize::from(new > 0) - usize::from(old > 0);
+        self.len[s] = new as u32;
+        let touched = old.max(new);
+        if touched > 0 {
+            let range = start..start + touched;
+            match self.dirty.last_mut() {
+                Some(last) if last.end + 1 >= range.start && last.start <= range.start => {
+                    last.end = range.end;
+                }
+                _ => self.dirty.push(range),
+            }
+        }
+    }
+
+    /// The LoD last extracted, if any.
+    #[must_use]
+    pub fn lod(&self) -> Option<usize> {
+        self.lod
+    }
+
+    /// The part of [`Extractor::buffer`] holding the current band's slots:
+    /// everything outside it is restart values, so a renderer may draw only
+    /// this range.
+    #[must_use]
+    pub fn active_range(&self) -> Range<usize> {
+        match self.band {
+            Some(b) => {
+                let strips = self.model.band_strips(b);
+                self.slot_start[strips.start] as usize..self.slot_start[strips.end] as usize
+            }
+            None => 0..0,
+        }
+    }
+
+    /// The slot-laid index buffer (restart value [`RESTART_U32`]).
+    #[must_use]
+    pub fn buffer(&self) -> &[u32] {
+        &self.buffer
+    }
+
+    /// Index ranges of [`Extractor::buffer`] rewritten by the last call,
+    /// ascending and disjoint (adjacent slots merged).
+    #[must_use]
+    pub fn dirty_ranges(&self) -> &[Range<usize>] {
+        &self.dirty
+    }
+
+    /// The current strip sequence of strip `s` (its run breaks included).
+    #[must_use]
+    pub fn strip(&self, s: usize) -> &[u32] {
+        let start = self.slot_start[s] as usize;
+        &self.buffer[start..start + self.len[s] as usize]
+    }
+
+    /// Indices a compact restart-encoded buffer of the current LoD holds:
+    /// every strip's sequence, one restart between non-empty strips.
+    #[must_use]
+    pub fn indices_sent(&self) -> usize {
+        self.used + self.non_empty.saturating_sub(1)
+    }
+
+    /// Strip walks that hit the end of their slot and were cut (always 0
+    /// for a model from [`super::build`]; a corrupt file can cause it).
+    #[must_use]
+    pub fn overflows(&self) -> usize {
+        self.overflows
+    }
+
+    /// Writes the current LoD without padding into `out` (cleared first):
+    /// [`Extractor::indices_sent`] indices.
+    pub fn write_compact(&self, out: &mut Vec<u32>) {
+        out.clear();
+        for s in 0..self.len.len() {
+            if self.len[s] > 0 {
+                if !out.is_empty() {
+                    out.push(RESTART_U32);
+                }
+                out.extend_from_slice(self.strip(s));
+            }
+        }
+    }
+
+    /// The oriented triangles the buffer draws, strip by strip
+    /// (degenerates skipped, odd triangles flipped).
+    #[must_use]
+    pub fn triangles(&self) -> Vec<[u32; 3]> {
+        let mut out = Vec::new();
+        for run in self.buffer.split(|&i| i == RESTART_U32) {
+            crate::strip::decode_run(run, &mut out);
+        }
+        out
+    }
+}
+
+/// Walks strip `s` at LoD `lod` into `out` (Fig. 5 of the paper), tracking
+/// the validity interval: the largest label skipped bounds it below, the
+/// smallest label taken above.
+fn walk(model: &MtsModel, s: usize, lod: u32, out: &mut [u32]) -> Walk {
+    let mut w = Walk {
+        len: 0,
+        from: 0,
+        to: model.max_lod() as u32,
+        overflow: false,
+    };
+    let begins = model.begins_of(s);
+    let mut b = begins.start;
+    while b < begins.end && model.begin_res[b] < lod {
+        w.from = w.from.max(model.begin_res[b] + 1);
+        b += 1;
+    }
+    if b == begins.end {
+        return w;
+    }
+    w.to = w.to.min(model.begin_res[b]);
+    let mut node = model.begin_node[b];
+    if node == END {
+        return w;
+    }
+    let mut len = 0usize;
+    loop {
+        let n = (node & NODE_MASK) as usize;
+        if len >= out.len() {
+            w.overflow = true;
+            break;
+        }
+        out[len] = model.node_vertex[n];
+        len += 1;
+        let (mut a, end) = (model.node_arcs[n] as usize, model.node_arcs[n + 1] as usize);
+        while a < end && model.arc_res[a] < lod {
+            w.from = w.from.max(model.arc_res[a] + 1);
+            a += 1;
+        }
+        if a == end {
+            break;
+        }
+        w.to = w.to.min(model.arc_res[a]);
+        let t = model.arc_target[a];
+        if t == END {
+            break;
+        }
+        if t & RESTART != 0 {
+            if len >= out.len() {
+                w.overflow = true;
+                break;
+            }
+            out[len] = RESTART_U32;
+            len += 1;
+        }
+        node = t;
+    }
+    w.len = len as u32;
+    w
+}
