@@ -16,7 +16,11 @@ fn check_all_lods(mesh: &Mesh, step: usize) {
     while lod <= collapses.max_lod() {
         coherent.set_lod(lod);
         scratch.set_lod_from_scratch(lod);
-        assert_eq!(coherent.buffer(), scratch.buffer(), "LoD {lod}: coherent differs");
+        assert_eq!(
+            coherent.buffer(),
+            scratch.buffer(),
+            "LoD {lod}: coherent differs"
+        );
         let want = sorted_canonical(&collapses.triangles_at(mesh, lod));
         let got = sorted_canonical(&scratch.triangles());
         assert_eq!(got.len(), want.len(), "LoD {lod}: triangle count");
@@ -29,4 +33,16 @@ fn check_all_lods(mesh: &Mesh, step: usize) {
 fn torus_every_lod() {
     let mesh: Mesh = "torus:2k".parse::<Generated>().unwrap().build();
     check_all_lods(&mesh, 1);
+}
+
+#[test]
+fn file_round_trip_builds_the_same_model() {
+    let mesh: Mesh = "icosphere:5k".parse::<Generated>().unwrap().build();
+    let strips = stripify(&mesh, &StripifyOptions::default());
+    let collapses = mts::simplify(&mesh, &SimplifyOptions::default()).collapses;
+    let m = model::build(&mesh, &strips, &collapses, &model::BuildOptions::default());
+    let bytes = m.to_bytes();
+    let back = mts::MtsModel::from_bytes(&bytes, std::path::Path::new("mem.mts")).unwrap();
+    assert_eq!(back, m);
+    println!("{} bytes, raw {}", bytes.len(), m.raw_bytes());
 }

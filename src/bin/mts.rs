@@ -33,6 +33,44 @@ enum Command {
     Distance(DistanceArgs),
     /// Write a mesh (a file or a generated one) as OBJ.
     Convert(ConvertArgs),
+    /// Build the MTS model (strips, contraction sequence, per-strip graphs)
+    /// and write it as an .mts file.
+    Build(BuildArgs),
+    /// Describe an .mts file: sizes, bands, and strip quality at several
+    /// LoDs against stripifying that LoD's mesh from scratch.
+    Info(InfoArgs),
+}
+
+#[derive(Args)]
+struct BuildArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// The .mts file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Start a new band of strips when they send this much more indices per
+    /// triangle than at the band's start (see BuildOptions::band_slack).
+    #[arg(long, default_value_t = mts::model::DEFAULT_BAND_SLACK)]
+    band_slack: f64,
+    /// One band only: the paper's model, whose strips degrade as the mesh
+    /// is simplified.
+    #[arg(long, conflicts_with = "band_slack")]
+    single_band: bool,
+    /// Optimal placement in the contraction sequence (new vertices).
+    #[arg(long)]
+    optimal: bool,
+}
+
+#[derive(Args)]
+struct InfoArgs {
+    /// The .mts file.
+    model: PathBuf,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Where a mesh comes from: a file or a built-in generator.
@@ -421,7 +459,206 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Simplify(args) => simplify(args),
         Command::Distance(args) => distance(args),
         Command::Convert(args) => convert(args),
+        Command::Build(args) => build(args),
+        Command::Info(args) => info(args),
     }
+}
+
+/// Inputs of this many triangles or more get a progress bar.
+const PROGRESS_MIN_TRIANGLES: usize = 200_000;
+
+fn build(args: &BuildArgs) -> Result<()> {
+    use indicatif::{ProgressBar, ProgressStyle};
+    use mts::model::{build_with_progress, BuildOptions};
+    use mts::simplify::{Placement, SimplifyOptions};
+    let (name, mesh, _) = args.source.load()?;
+    let bar = if mesh.triangle_count() >= PROGRESS_MIN_TRIANGLES {
+        ProgressBar::new(4)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg:12} [{bar:30}] {pos}/{len} {elapsed}")
+            .expect("valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let t0 = Instant::now();
+    bar.set_message("stripify");
+    let strips = stripify(&mesh, &StripifyOptions::default());
+    let t_strips = t0.elapsed();
+    bar.set_message("simplify");
+    let options = SimplifyOptions {
+        placement: if args.optimal {
+            Placement::Optimal
+        } else {
+            Placement::Endpoint
+        },
+        ..SimplifyOptions::default()
+    };
+    let simplification = mts::simplify(&mesh, &options);
+    let t_simplify = t0.elapsed() - t_strips;
+    let collapses = simplification.collapses;
+    bar.set_message("model");
+    bar.set_length(collapses.max_lod().max(1) as u64);
+    let build_options = BuildOptions {
+        band_slack: if args.single_band {
+            f64::INFINITY
+        } else {
+            args.band_slack
+        },
+        ..BuildOptions::default()
+    };
+    let t1 = Instant::now();
+    let model = build_with_progress(
+        &mesh,
+        &strips,
+        &collapses,
+        &build_options,
+        &mut |done, _| {
+            bar.set_position(done as u64);
+        },
+    );
+    let t_model = t1.elapsed();
+    let total = t0.elapsed();
+    bar.finish_and_clear();
+    let bytes = model.to_bytes();
+    std::fs::write(&args.output, &bytes)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let st = model.stats();
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "input_triangles": mesh.triangle_count(),
+                "vertices": mesh.vertex_count(),
+                "max_lod": model.max_lod(),
+                "strips": st.strips,
+                "bands": model.band_count(),
+                "nodes": st.nodes,
+                "arcs": st.arcs,
+                "memory_bytes": st.memory_bytes,
+                "file_bytes": bytes.len(),
+                "raw_bytes": model.raw_bytes(),
+                "ms_stripify": ms(t_strips),
+                "ms_simplify": ms(t_simplify),
+                "ms_model": ms(t_model),
+                "ms": ms(total),
+            })
+        );
+    } else {
+        println!(
+            "{name}: {} triangles, {} vertices, {} LoDs",
+            mesh.triangle_count(),
+            mesh.vertex_count(),
+            model.max_lod() + 1
+        );
+        println!(
+            "  time      stripify {:.1} ms, simplify {:.1} ms, model {:.1} ms, total {:.1} ms",
+            ms(t_strips),
+            ms(t_simplify),
+            ms(t_model),
+            ms(total)
+        );
+        println!(
+            "  model     {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
+            model.band_count(),
+            st.strips,
+            st.nodes,
+            st.arcs,
+            st.memory_bytes as f64 / 1e6
+        );
+        println!(
+            "  file      {} bytes = {:.2} x raw ({} bytes: 12 per vertex + 6 per triangle) -> {}",
+            bytes.len(),
+            bytes.len() as f64 / model.raw_bytes() as f64,
+            model.raw_bytes(),
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+fn info(args: &InfoArgs) -> Result<()> {
+    use mts::{Extractor, MtsModel};
+    let t0 = Instant::now();
+    let model = MtsModel::load(&args.model)?;
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let file_bytes = std::fs::metadata(&args.model)
+        .with_context(|| format!("cannot read {}", args.model.display()))?
+        .len();
+    let st = model.stats();
+    let mesh = model.mesh();
+    let mut ex = Extractor::new(&model);
+    let mut levels = Vec::new();
+    for ratio in [1.0, 0.5, 0.25, 0.1, 0.05, 0.01] {
+        let lod = model.lod_for_ratio(ratio);
+        ex.set_lod(lod);
+        let triangles = model.triangle_count(lod);
+        let fresh = stripify(
+            &model.collapses().mesh_at(&mesh, lod),
+            &StripifyOptions::default(),
+        );
+        let ours = ex.indices_sent() as f64 / triangles.max(1) as f64;
+        let theirs = fresh.restart_index_count() as f64 / triangles.max(1) as f64;
+        levels.push(json!({
+            "ratio": ratio,
+            "lod": lod,
+            "triangles": triangles,
+            "indices": ex.indices_sent(),
+            "indices_per_triangle": ours,
+            "restripified_indices_per_triangle": theirs,
+            "quality_ratio": ours / theirs,
+        }));
+    }
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "file": args.model.display().to_string(),
+                "file_bytes": file_bytes,
+                "raw_bytes": model.raw_bytes(),
+                "load_ms": load_ms,
+                "vertices": model.positions().len(),
+                "triangles": model.triangle_count(0),
+                "max_lod": model.max_lod(),
+                "bands": model.band_count(),
+                "strips": st.strips,
+                "nodes": st.nodes,
+                "arcs": st.arcs,
+                "memory_bytes": st.memory_bytes,
+                "levels": levels,
+            })
+        );
+    } else {
+        println!(
+            "{}: {} bytes ({:.2} x raw), loaded and built in {load_ms:.1} ms",
+            args.model.display(),
+            file_bytes,
+            file_bytes as f64 / model.raw_bytes() as f64
+        );
+        println!("  {} vertices, {} triangles, {} LoDs, {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
+            model.positions().len(), model.triangle_count(0), model.max_lod() + 1, model.band_count(), st.strips, st.nodes, st.arcs, st.memory_bytes as f64 / 1e6);
+        println!(
+            "  {:>6} {:>7} {:>9} {:>9} {:>11} {:>7}",
+            "share", "LoD", "triangles", "idx/tri", "restripify", "ratio"
+        );
+        for l in &levels {
+            println!(
+                "  {:>5.0}% {:>7} {:>9} {:>9.3} {:>11.3} {:>7.3}",
+                l["ratio"].as_f64().unwrap_or(0.0) * 100.0,
+                l["lod"].as_u64().unwrap_or(0),
+                l["triangles"].as_u64().unwrap_or(0),
+                l["indices_per_triangle"].as_f64().unwrap_or(0.0),
+                l["restripified_indices_per_triangle"]
+                    .as_f64()
+                    .unwrap_or(0.0),
+                l["quality_ratio"].as_f64().unwrap_or(0.0),
+            );
+        }
+    }
+    Ok(())
 }
 
 fn main() -> std::process::ExitCode {

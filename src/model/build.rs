@@ -53,7 +53,7 @@
 //! windows. So construction costs O(positions + total strip changes), not
 //! strips × LoDs.
 
-use super::{MtsModel, END, NODE_MASK, RESTART};
+use super::{MtsModel, Recipe, END, NODE_MASK, RESTART};
 use crate::mesh::Mesh;
 use crate::simplify::Collapses;
 use crate::strip::{stripify, StripifyOptions, Strips};
@@ -92,6 +92,15 @@ impl Default for BuildOptions {
 /// See [`BuildOptions::band_slack`] and `ARCHITECTURE.md` ("MTS model").
 pub const DEFAULT_BAND_SLACK: f64 = 0.10;
 
+/// Smallest band slack used (smaller values are raised to it).
+pub const MIN_BAND_SLACK: f64 = 0.01;
+
+/// A band lasts until its triangle count has fallen by at least this
+/// fraction (or to the last LoD). With it the number of bands is at most
+/// about `ln(triangles) / 0.02` whatever the strips do, so a file cannot
+/// make the loader stripify once per LoD.
+pub const MIN_BAND_DROP: f64 = 0.02;
+
 /// Builds the MTS model of `mesh` from its strips (those of LoD 0) and its
 /// contraction sequence; later bands are stripified from the mesh at their
 /// first LoD with `options.stripify`.
@@ -100,9 +109,37 @@ pub const DEFAULT_BAND_SLACK: f64 = 0.10;
 /// If `strips` or `collapses` were not made for `mesh` (different vertex
 /// counts), or the strips do not index `mesh`'s vertices.
 #[must_use]
-pub fn build(mesh: &Mesh, strips: &Strips, collapses: &Collapses, options: &BuildOptions) -> MtsModel {
-    assert_eq!(strips.vertex_count() as usize, mesh.vertex_count(), "strips of another mesh");
-    assert_eq!(collapses.vertex_count(), mesh.vertex_count(), "collapses of another mesh");
+pub fn build(
+    mesh: &Mesh,
+    strips: &Strips,
+    collapses: &Collapses,
+    options: &BuildOptions,
+) -> MtsModel {
+    build_with_progress(mesh, strips, collapses, options, &mut |_, _| {})
+}
+
+/// [`build`], calling `progress(lods_done, max_lod)` as LoDs are replayed.
+///
+/// # Panics
+/// As [`build`].
+#[must_use]
+pub fn build_with_progress(
+    mesh: &Mesh,
+    strips: &Strips,
+    collapses: &Collapses,
+    options: &BuildOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> MtsModel {
+    assert_eq!(
+        strips.vertex_count() as usize,
+        mesh.vertex_count(),
+        "strips of another mesh"
+    );
+    assert_eq!(
+        collapses.vertex_count(),
+        mesh.vertex_count(),
+        "collapses of another mesh"
+    );
     let max_lod = collapses.max_lod() as u32;
     let counts = collapses.triangle_counts();
     let mut positions = mesh.positions.clone();
@@ -113,8 +150,26 @@ pub fn build(mesh: &Mesh, strips: &Strips, collapses: &Collapses, options: &Buil
         strip_nodes: vec![0],
         strip_begins: vec![0],
         band_strips: vec![0],
-        ..MtsModel::default()
+        begin_node: Vec::new(),
+        begin_res: Vec::new(),
+        node_vertex: Vec::new(),
+        node_arcs: Vec::new(),
+        arc_target: Vec::new(),
+        arc_res: Vec::new(),
+        band_lod: Vec::new(),
+        recipe: Recipe {
+            strips: strips.clone(),
+            collapses: collapses.clone(),
+            options: options.clone(),
+        },
     };
+    // Bands are stripified from the strips' own triangles, so that a model
+    // built again from its file (which stores the strips) is the same.
+    let base = Mesh {
+        positions: mesh.positions.clone(),
+        triangles: strips.triangles(),
+    };
+    let slack = options.band_slack.max(MIN_BAND_SLACK);
     let vertex_total = model.positions.len();
     let optimal = collapses.is_optimal_placement();
     let mut moved = Vec::with_capacity(2);
@@ -126,15 +181,16 @@ pub fn build(mesh: &Mesh, strips: &Strips, collapses: &Collapses, options: &Buil
         } else {
             let at = Mesh {
                 positions: model.positions.clone(),
-                triangles: collapses.triangles_at(mesh, first as usize),
+                triangles: collapses.triangles_at(&base, first as usize),
             };
             band_strips = stripify(&at, &options.stripify);
             &band_strips
         };
         let mut builder = Builder::new(strips, vertex_total, first);
         // Indices the band may send per triangle before the next band starts.
-        let limit = (1.0 + options.band_slack) * builder.indices() as f64
-            / f64::from(counts[first as usize].max(1));
+        let start = counts[first as usize];
+        let limit = (1.0 + slack) * builder.indices() as f64 / f64::from(start.max(1));
+        let min_drop = (f64::from(start) * (1.0 - MIN_BAND_DROP)) as u32;
         let mut last = max_lod;
         for k in first + 1..=max_lod {
             let i = k as usize - 1;
@@ -145,7 +201,8 @@ pub fn build(mesh: &Mesh, strips: &Strips, collapses: &Collapses, options: &Buil
                 moved.push(step.kept);
             }
             builder.contract(k, &moved, collapses.target(i));
-            if builder.indices() as f64 > limit * f64::from(counts[k as usize]) {
+            let now = counts[k as usize];
+            if now <= min_drop && builder.indices() as f64 > limit * f64::from(now) {
                 last = k - 1;
                 break;
             }
@@ -153,6 +210,7 @@ pub fn build(mesh: &Mesh, strips: &Strips, collapses: &Collapses, options: &Buil
         model.band_lod.push(first);
         builder.finish_into(&mut model, first, last, max_lod);
         model.band_strips.push(model.strip_nodes.len() as u32 - 1);
+        progress(last as usize, max_lod as usize);
         if last == max_lod {
             break;
         }
@@ -229,7 +287,10 @@ impl Builder {
     /// already those of that LoD).
     fn new(strips: &Strips, vertex_count: usize, first: u32) -> Builder {
         let total: usize = strips.runs().map(<[u32]>::len).sum();
-        assert!(total < NODE_MASK as usize, "strips too long for 31-bit node indices");
+        assert!(
+            total < NODE_MASK as usize,
+            "strips too long for 31-bit node indices"
+        );
         let mut b = Builder {
             pos_strip: Vec::with_capacity(total),
             strip_base: Vec::with_capacity(strips.run_count() + 1),
@@ -277,9 +338,20 @@ impl Builder {
             for p in 0..len {
                 let gp = base + p;
                 let live = b.live[gp as usize];
-                b.prev_link.push(if live { gp } else if p == 0 { NONE } else { gp - 1 });
-                b.next_link
-                    .push(if live { gp } else if p + 3 >= len { NONE } else { gp + 1 });
+                b.prev_link.push(if live {
+                    gp
+                } else if p == 0 {
+                    NONE
+                } else {
+                    gp - 1
+                });
+                b.next_link.push(if live {
+                    gp
+                } else if p + 3 >= len {
+                    NONE
+                } else {
+                    gp + 1
+                });
             }
             // LoD 0: the rule applied to the whole run.
             b.included[base as usize..(base + len) as usize].fill(false);
@@ -363,7 +435,11 @@ impl Builder {
     /// before". Returns the first live window emitted, if any.
     fn encode_span(&mut self, s: usize, a_prev: Option<u32>, b_next: Option<u32>) -> Option<u32> {
         let base = self.strip_base[s];
-        let end = self.strip_base.get(s + 1).copied().unwrap_or(self.cur.len() as u32);
+        let end = self
+            .strip_base
+            .get(s + 1)
+            .copied()
+            .unwrap_or(self.cur.len() as u32);
         self.new_span.clear();
         let mut prev = a_prev;
         let mut last_emitted = a_prev.map(|a| a + 2);
@@ -392,7 +468,8 @@ impl Builder {
                 if last_emitted.is_some_and(|l| p <= l) {
                     continue;
                 }
-                self.new_span.push((p, i == 0 && !contiguous && prev.is_some()));
+                self.new_span
+                    .push((p, i == 0 && !contiguous && prev.is_some()));
             }
             last_emitted = Some(b + 2);
             prev = Some(b);
@@ -425,7 +502,11 @@ impl Builder {
         let t = self.node_open[n as usize];
         if t != NONE {
             if self.node_since[n as usize] <= res {
-                self.closed.push(ArcRecord { node: n, target: t, res });
+                self.closed.push(ArcRecord {
+                    node: n,
+                    target: t,
+                    res,
+                });
             }
             self.node_open[n as usize] = NONE;
         }
@@ -452,7 +533,10 @@ impl Builder {
     fn commit_new_span(&mut self, a_prev: Option<u32>, b_next: Option<u32>, lod: u32) -> u32 {
         let span = std::mem::take(&mut self.new_span);
         for &(p, _) in &span {
-            debug_assert!(!self.replaying || self.included[p as usize], "position {p} came back");
+            debug_assert!(
+                !self.replaying || self.included[p as usize],
+                "position {p} came back"
+            );
             self.emitted += usize::from(!self.included[p as usize]);
             self.included[p as usize] = true;
             self.mark[p as usize] = self.stamp;
@@ -523,7 +607,11 @@ impl Builder {
                 if w + 2 >= end || !self.live[w as usize] {
                     continue;
                 }
-                let (x, y, z) = (self.cur[w as usize], self.cur[w as usize + 1], self.cur[w as usize + 2]);
+                let (x, y, z) = (
+                    self.cur[w as usize],
+                    self.cur[w as usize + 1],
+                    self.cur[w as usize + 2],
+                );
                 if x == y || y == z || x == z {
                     self.live[w as usize] = false;
                     self.prev_link[w as usize] = if w == base { NONE } else { w - 1 };
@@ -542,7 +630,11 @@ impl Builder {
             let mut j = i;
             let b_next = loop {
                 let hi = touched[j];
-                let b = if hi + 1 + 2 < end { self.find_next(hi + 1) } else { None };
+                let b = if hi + 1 + 2 < end {
+                    self.find_next(hi + 1)
+                } else {
+                    None
+                };
                 let joins = j + 1 < touched.len()
                     && self.pos_strip[touched[j + 1] as usize] as usize == s
                     && b.is_none_or(|b| b + 2 >= touched[j + 1]);
@@ -552,7 +644,11 @@ impl Builder {
                     break b;
                 }
             };
-            let a_prev = if lo >= base + 3 { self.find_prev(lo - 3) } else { None };
+            let a_prev = if lo >= base + 3 {
+                self.find_prev(lo - 3)
+            } else {
+                None
+            };
             self.respan(s, a_prev, b_next, lod);
             i = j + 1;
         }
@@ -609,7 +705,8 @@ impl Builder {
                 }
                 self.begin_open[s] = first;
                 self.begin_since[s] = lod;
-                self.non_empty = self.non_empty + usize::from(first != END) - usize::from(old != END);
+                self.non_empty =
+                    self.non_empty + usize::from(first != END) - usize::from(old != END);
             }
         }
     }
@@ -628,7 +725,13 @@ impl Builder {
         for (i, &n) in order.iter().enumerate() {
             new_id[n as usize] = node_base + i as u32;
         }
-        let remap = |t: u32| if t == END { END } else { new_id[(t & NODE_MASK) as usize] | (t & RESTART) };
+        let remap = |t: u32| {
+            if t == END {
+                END
+            } else {
+                new_id[(t & NODE_MASK) as usize] | (t & RESTART)
+            }
+        };
         let strips = self.strip_base.len() - 1;
         let mut per_strip = vec![0u32; strips];
         for &n in &order {
@@ -666,7 +769,8 @@ impl Builder {
         // one, empty after the band.
         for s in 0..strips {
             if self.begin_since[s] <= last {
-                self.begins_closed.push((s as u32, self.begin_open[s], last));
+                self.begins_closed
+                    .push((s as u32, self.begin_open[s], last));
             }
             if first > 0 {
                 self.begins_closed.push((s as u32, END, first - 1));
@@ -677,8 +781,12 @@ impl Builder {
         }
         self.begins_closed.sort_by_key(|&(s, _, res)| (s, res));
         for s in 0..strips {
-            let start = self.begins_closed.partition_point(|&(t, _, _)| (t as usize) < s);
-            let end = self.begins_closed.partition_point(|&(t, _, _)| (t as usize) <= s);
+            let start = self
+                .begins_closed
+                .partition_point(|&(t, _, _)| (t as usize) < s);
+            let end = self
+                .begins_closed
+                .partition_point(|&(t, _, _)| (t as usize) <= s);
             for &(_, n, res) in &self.begins_closed[start..end] {
                 model.begin_node.push(remap(n));
                 model.begin_res.push(res);

@@ -29,9 +29,11 @@
 
 mod build;
 mod extract;
-// pub mod format;
+pub mod format;
 
-pub use build::{build, BuildOptions, DEFAULT_BAND_SLACK};
+pub use build::{
+    build, build_with_progress, BuildOptions, DEFAULT_BAND_SLACK, MIN_BAND_DROP, MIN_BAND_SLACK,
+};
 pub use extract::{Extractor, Update};
 
 use glam::Vec3;
@@ -55,7 +57,7 @@ pub const NODE_MASK: u32 = RESTART - 1;
 /// strictly increasing along a node's arcs and along a strip's beginnings,
 /// and a strip's last beginning has label `max_lod`; the triangle table has
 /// `max_lod + 1` non-increasing entries.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MtsModel {
     pub(crate) positions: Vec<Vec3>,
     pub(crate) triangle_counts: Vec<u32>,
@@ -75,6 +77,17 @@ pub struct MtsModel {
     /// (`band_strips[b]..band_strips[b + 1]`).
     pub(crate) band_lod: Vec<u32>,
     pub(crate) band_strips: Vec<u32>,
+    /// What the model was built from; the `.mts` file stores this and the
+    /// loader builds the graphs again (see [`format`]).
+    pub(crate) recipe: Recipe,
+}
+
+/// The inputs of [`build`]: enough to build the same model again.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Recipe {
+    pub(crate) strips: crate::strip::Strips,
+    pub(crate) collapses: crate::simplify::Collapses,
+    pub(crate) options: BuildOptions,
 }
 
 /// Sizes of a model, for reports.
@@ -142,6 +155,34 @@ impl MtsModel {
         self.lod_for_triangles((ratio.clamp(0.0, 1.0) * full).round() as usize)
     }
 
+    /// The contraction sequence the model was built from.
+    #[must_use]
+    pub fn collapses(&self) -> &crate::simplify::Collapses {
+        &self.recipe.collapses
+    }
+
+    /// The strips of LoD 0 the model was built from.
+    #[must_use]
+    pub fn base_strips(&self) -> &crate::strip::Strips {
+        &self.recipe.strips
+    }
+
+    /// The options the model was built with.
+    #[must_use]
+    pub fn build_options(&self) -> &BuildOptions {
+        &self.recipe.options
+    }
+
+    /// The full-resolution mesh: the input vertices and the triangles of
+    /// the LoD-0 strips (in strip order).
+    #[must_use]
+    pub fn mesh(&self) -> crate::Mesh {
+        crate::Mesh {
+            positions: self.positions[..self.recipe.collapses.vertex_count()].to_vec(),
+            triangles: self.recipe.strips.triangles(),
+        }
+    }
+
     /// Number of bands (strip sets stripified afresh at a LoD).
     #[must_use]
     pub fn band_count(&self) -> usize {
@@ -151,7 +192,9 @@ impl MtsModel {
     /// The band that draws `lod`.
     #[must_use]
     pub fn band_of(&self, lod: usize) -> usize {
-        self.band_lod.partition_point(|&b| b as usize <= lod).saturating_sub(1)
+        self.band_lod
+            .partition_point(|&b| b as usize <= lod)
+            .saturating_sub(1)
     }
 
     /// First LoD of band `b`.
@@ -229,7 +272,8 @@ impl MtsModel {
         if self.node_arcs.len() != self.node_vertex.len() + 1 {
             return Err("arc offsets do not match the node count".into());
         }
-        if self.begin_res.len() != self.begin_node.len() || self.arc_res.len() != self.arc_target.len()
+        if self.begin_res.len() != self.begin_node.len()
+            || self.arc_res.len() != self.arc_target.len()
         {
             return Err("label arrays do not match their targets".into());
         }
@@ -248,7 +292,10 @@ impl MtsModel {
         }
         let vertices = self.positions.len() as u32;
         if let Some(n) = self.node_vertex.iter().position(|&v| v >= vertices) {
-            return Err(format!("node {n} names vertex {} of {vertices}", self.node_vertex[n]));
+            return Err(format!(
+                "node {n} names vertex {} of {vertices}",
+                self.node_vertex[n]
+            ));
         }
         if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("vertex {v} is not finite"));
@@ -261,14 +308,21 @@ impl MtsModel {
                 return Err(format!("strip {s} has no beginning"));
             }
             for b in begins.clone() {
-                if !in_strip(self.begin_node[b]) || (self.begin_node[b] != END && self.begin_node[b] & RESTART != 0) {
-                    return Err(format!("strip {s} beginning {b} names node {:#x} outside the strip", self.begin_node[b]));
+                if !in_strip(self.begin_node[b])
+                    || (self.begin_node[b] != END && self.begin_node[b] & RESTART != 0)
+                {
+                    return Err(format!(
+                        "strip {s} beginning {b} names node {:#x} outside the strip",
+                        self.begin_node[b]
+                    ));
                 }
             }
             check_labels(&self.begin_res[begins.clone()], max_lod)
                 .map_err(|e| format!("strip {s} beginnings: {e}"))?;
             if self.begin_res[begins.end - 1] != max_lod {
-                return Err(format!("strip {s}: last beginning is not labelled {max_lod}"));
+                return Err(format!(
+                    "strip {s}: last beginning is not labelled {max_lod}"
+                ));
             }
             for n in nodes.clone() {
                 let arcs = self.node_arcs[n] as usize..self.node_arcs[n + 1] as usize;

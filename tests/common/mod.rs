@@ -72,4 +72,3 @@ pub fn model(name: &str) -> Option<Mesh> {
     }
     Some(load(&path, LoadOptions::default()).unwrap().0)
 }
-
