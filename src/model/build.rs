@@ -57,9 +57,14 @@ use super::{MtsModel, Recipe, END, NODE_MASK, RESTART};
 use crate::mesh::Mesh;
 use crate::simplify::Collapses;
 use crate::strip::{stripify, StripifyOptions, Strips};
+#[cfg(test)]
+use glam::Vec3;
 
 /// "None" in the construction's index arrays.
 const NONE: u32 = u32::MAX;
+/// "No open arc" for a node: distinct from [`END`] (`u32::MAX`), which is
+/// an arc; node indices stay below `2^31 - 1`, so no target reaches it.
+const NO_ARC: u32 = u32::MAX - 1;
 
 /// How the model is built.
 #[derive(Debug, Clone, PartialEq)]
@@ -254,7 +259,7 @@ struct Builder {
     occ_tail: Vec<u32>,
     occ_next: Vec<u32>,
     /// Nodes: position and vertex, and the arc currently open (target or
-    /// [`NONE`]).
+    /// [`NO_ARC`]).
     node_pos: Vec<u32>,
     node_vertex: Vec<u32>,
     node_open: Vec<u32>,
@@ -490,7 +495,7 @@ impl Builder {
         let n = self.node_pos.len() as u32;
         self.node_pos.push(gp);
         self.node_vertex.push(self.cur[gp as usize]);
-        self.node_open.push(NONE);
+        self.node_open.push(NO_ARC);
         self.node_since.push(0);
         self.node_of[gp as usize] = n;
         n
@@ -500,7 +505,7 @@ impl Builder {
     /// never held (opened after `res`) leaves no record.
     fn close(&mut self, n: u32, res: u32) {
         let t = self.node_open[n as usize];
-        if t != NONE {
+        if t != NO_ARC {
             if self.node_since[n as usize] <= res {
                 self.closed.push(ArcRecord {
                     node: n,
@@ -508,7 +513,7 @@ impl Builder {
                     res,
                 });
             }
-            self.node_open[n as usize] = NONE;
+            self.node_open[n as usize] = NO_ARC;
         }
     }
 
@@ -518,7 +523,7 @@ impl Builder {
         if open == target {
             return;
         }
-        if open != NONE && lod > 0 {
+        if open != NO_ARC && lod > 0 {
             self.close(n, lod - 1);
         }
         self.node_open[n as usize] = target;
@@ -799,5 +804,128 @@ impl Builder {
 fn prefix_sum(v: &mut [u32]) {
     for i in 1..v.len() {
         v[i] += v[i - 1];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Extractor;
+    use crate::simplify::{Collapse, Collapses};
+    use crate::strip::encode::RESTART_U32;
+    use crate::strip::sorted_canonical;
+
+    /// A row of quads: vertices `0..2n+2`, bottom row even, top row odd,
+    /// stripped as the single run `0 1 2 3 …` (triangle `i` is `(i, i+1,
+    /// i+2)` for even `i`, `(i+1, i, i+2)` for odd `i`).
+    fn quad_row(n: u32) -> (Mesh, Strips) {
+        let positions = (0..2 * n + 2)
+            .map(|i| Vec3::new((i / 2) as f32, (i % 2) as f32, 0.0))
+            .collect();
+        let run: Vec<u32> = (0..2 * n + 2).collect();
+        let strips = Strips::from_runs([&run[..]], 2 * n + 2).unwrap();
+        let mesh = Mesh {
+            positions,
+            triangles: strips.triangles(),
+        };
+        (mesh, strips)
+    }
+
+    /// The model of `steps` (removed, kept) over `mesh`, one band.
+    fn model_of(mesh: &Mesh, strips: &Strips, steps: &[(u32, u32)]) -> (MtsModel, Collapses) {
+        let steps: Vec<Collapse> = steps
+            .iter()
+            .map(|&(removed, kept)| Collapse {
+                removed,
+                kept,
+                error: 0.0,
+            })
+            .collect();
+        let counts = crate::model::format::replay_counts(mesh, &steps, false);
+        let collapses = Collapses::new(mesh.vertex_count(), steps, counts, Vec::new());
+        let options = BuildOptions {
+            band_slack: f64::INFINITY,
+            ..BuildOptions::default()
+        };
+        (build(mesh, strips, &collapses, &options), collapses)
+    }
+
+    /// The strip's sequence at every LoD, checked against the oracle.
+    fn sequences(mesh: &Mesh, model: &MtsModel, collapses: &Collapses) -> Vec<Vec<u32>> {
+        let mut ex = Extractor::new(model);
+        (0..=model.max_lod())
+            .map(|lod| {
+                ex.set_lod(lod);
+                assert_eq!(
+                    sorted_canonical(&ex.triangles()),
+                    sorted_canonical(&collapses.triangles_at(mesh, lod)),
+                    "LoD {lod}"
+                );
+                ex.strip(0).to_vec()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_vertex_visited_twice_gets_two_nodes() {
+        // 0 1 2 1 3: the swap at 1 makes the strip visit vertex 1 twice.
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+        let strips = Strips::from_runs([&[0, 1, 2, 1, 3][..]], 4).unwrap();
+        let mesh = Mesh {
+            positions,
+            triangles: strips.triangles(),
+        };
+        let (model, collapses) = model_of(&mesh, &strips, &[]);
+        let ones = model.node_vertex.iter().filter(|&&v| v == 1).count();
+        assert_eq!(ones, 2, "one node per occurrence");
+        // Each node has exactly one arc, so no walk has to choose.
+        assert_eq!(model.arc_target.len(), model.node_vertex.len());
+        assert_eq!(
+            sequences(&mesh, &model, &collapses),
+            vec![vec![0, 1, 2, 1, 3]]
+        );
+    }
+
+    #[test]
+    fn a_lost_turn_keeps_orientation_through_the_repeated_vertex() {
+        // Contracting the rung 2-3 removes triangles 1 and 2; the strip keeps
+        // its positions (0 1 3 3 4 5…): triangle 3 stays odd, so flipped.
+        let (mesh, strips) = quad_row(4);
+        let (model, collapses) = model_of(&mesh, &strips, &[(2, 3)]);
+        let seq = sequences(&mesh, &model, &collapses);
+        assert_eq!(seq[0], (0..10).collect::<Vec<u32>>());
+        assert_eq!(seq[1], vec![0, 1, 3, 3, 4, 5, 6, 7, 8, 9]);
+    }
+
+    #[test]
+    fn a_long_gap_becomes_a_break_that_keeps_parity() {
+        // Contract the middle of a row of 6 quads until its triangles 2..=6
+        // are gone: the strip ends after triangle 1 and starts again with a
+        // parity vertex before triangle 7 (odd), behind a restart.
+        let (mesh, strips) = quad_row(6);
+        let (model, collapses) = model_of(&mesh, &strips, &[(4, 5), (6, 5), (3, 5), (7, 5)]);
+        let seq = sequences(&mesh, &model, &collapses);
+        // LoD 4: s' = 0 1 2 5 5 5 5 5 8 9 10 11 13; live windows 0, 1 and
+        // 7 (5 8 9)... the rule decides; the oracle check above holds at
+        // every LoD, and the sequence never grows.
+        for w in seq.windows(2) {
+            assert!(w[1].len() <= w[0].len(), "sequence grew: {w:?}");
+        }
+        assert!(
+            seq.last().unwrap().contains(&RESTART_U32),
+            "{:?}",
+            seq.last()
+        );
+    }
+
+    #[test]
+    fn the_strip_end_moves_back_when_its_last_triangles_die() {
+        let (mesh, strips) = quad_row(2);
+        // Remove the last quad's triangles: 4 -> 5? no: contract 5 onto 3.
+        let (model, collapses) = model_of(&mesh, &strips, &[(5, 3)]);
+        let seq = sequences(&mesh, &model, &collapses);
+        assert_eq!(seq[0], vec![0, 1, 2, 3, 4, 5]);
+        // s' = 0 1 2 3 4 3: window 2 (2 3 4) lives, window 3 (3 4 3) dies.
+        assert_eq!(seq[1], vec![0, 1, 2, 3, 4]);
     }
 }

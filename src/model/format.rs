@@ -157,6 +157,20 @@ impl MtsModel {
     }
 }
 
+/// Rewrites the header's file length and checksum to match `bytes` (for
+/// tests and fuzzing that alter a file's content on purpose, so that the
+/// loader's checks past the checksum are reached). Does nothing to bytes
+/// shorter than a header.
+pub fn seal(bytes: &mut [u8]) {
+    if bytes.len() < HEADER_LEN {
+        return;
+    }
+    let len = bytes.len() as u64;
+    bytes[16..24].copy_from_slice(&len.to_le_bytes());
+    let sum = fnv1a(&bytes[HEADER_LEN..]);
+    bytes[24..32].copy_from_slice(&sum.to_le_bytes());
+}
+
 /// What a file holds, validated.
 struct Parsed {
     mesh: Mesh,
@@ -540,7 +554,7 @@ fn flag(r: &mut Reader<'_>, what: &str) -> Result<bool> {
 /// The triangle count after each step of a checked sequence: triangles of
 /// each vertex in per-vertex lists, moved onto the target as it replaces
 /// the vertex. O(triangles + moved entries).
-fn replay_counts(mesh: &Mesh, steps: &[Collapse], optimal: bool) -> Vec<u32> {
+pub(crate) fn replay_counts(mesh: &Mesh, steps: &[Collapse], optimal: bool) -> Vec<u32> {
     let total = mesh.vertex_count() + if optimal { steps.len() } else { 0 };
     let mut tris = mesh.triangles.clone();
     let mut of: Vec<Vec<u32>> = vec![Vec::new(); total];
