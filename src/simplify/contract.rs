@@ -9,9 +9,10 @@
 //!   [`Contractor::cost`]); face planes weigh `sqrt(area)`. The recorded
 //!   error is the square root of that cost relative to the bounding-box
 //!   diagonal, as a running maximum so it never decreases.
-//! - **One queue entry per vertex**: its cheapest allowed target, stamped
-//!   with a per-vertex version; refreshing a vertex bumps the version, so
-//!   older entries go stale. After `a → b` the survivor and `a`'s
+//! - **One queue entry per vertex**: its cheapest allowed target. The
+//!   queue (`queue.rs`) holds 8-byte `(cost, vertex)` keys; the vertex's
+//!   current cost and target live beside it, and a popped key whose cost is
+//!   no longer the vertex's is stale. After `a → b` the survivor and `a`'s
 //!   neighbours choose again; `b`'s other neighbours keep their choice.
 //! - **A refused target is remembered per vertex** until its
 //!   neighbourhood changes, and the vertex picks its next best. Validity
@@ -37,11 +38,10 @@
 use super::collapses::{Collapse, Collapses};
 use super::pairs::{vertex_triangles, virtual_pairs};
 use super::quadric::Quadric;
+use super::queue::{cost_bits, key, Queue};
 use super::{Placement, Simplification, SimplifyOptions, Stop, StopReason};
 use crate::mesh::{Mesh, TriangleAdjacency, NO_NEIGHBOUR};
 use glam::DVec3;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 
 /// Computes the whole contraction sequence of `mesh`.
 ///
@@ -60,42 +60,8 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     c.finish()
 }
 
-/// A queue entry: the cheapest allowed contraction of `vertex` (into
-/// `target`, or both into a new vertex in optimal mode) at cost `cost`.
-#[derive(Clone, Copy)]
-struct Entry {
-    cost: f32,
-    vertex: u32,
-    target: u32,
-    /// `version[vertex]` when queued: the entry is current while it holds.
-    stamp: u32,
-}
-
 /// "No target" in [`Contractor::queued`].
 const NONE: u32 = u32::MAX;
-
-impl PartialEq for Entry {
-    fn eq(&self, other: &Entry) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Entry) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Entry {
-    /// Reversed on cost, so the max-heap pops the cheapest; ties broken by
-    /// vertex indices so the sequence is deterministic.
-    fn cmp(&self, other: &Entry) -> Ordering {
-        other
-            .cost
-            .total_cmp(&self.cost)
-            .then(other.vertex.cmp(&self.vertex))
-            .then(other.target.cmp(&self.target))
-    }
-}
 
 /// Why a guard refused a contraction.
 enum Reject {
@@ -122,11 +88,12 @@ struct Contractor {
     /// Virtual partners of each vertex (empty unless enabled).
     partners: Vec<Vec<u32>>,
     removed: Vec<bool>,
-    version: Vec<u32>,
     /// Scratch marks per vertex, compared with `epoch`.
     mark: Vec<u32>,
     epoch: u32,
-    heap: BinaryHeap<Entry>,
+    /// One key per [`Contractor::queue`] call; a key is current while its
+    /// cost equals the vertex's queued cost (older ones are skipped).
+    heap: Queue,
     /// The (cost, target) of each vertex's current queue entry.
     queued: Vec<(f32, u32)>,
     /// Targets a guard refused for each vertex since its neighbourhood last
@@ -238,10 +205,9 @@ impl Contractor {
             vertex_tris,
             partners,
             removed: vec![false; n],
-            version: vec![0; n],
             mark: vec![0; n],
             epoch: 0,
-            heap: BinaryHeap::new(),
+            heap: Queue::with_capacity(2 * n),
             queued: vec![(f32::NAN, NONE); n],
             blocked: vec![Vec::new(); n],
             blocked_count: 0,
@@ -332,18 +298,14 @@ impl Contractor {
     }
 
     /// Makes `v → target` at `cost` the vertex's one current entry (no
-    /// entry for [`NONE`]); older entries of `v` go stale.
+    /// entry for [`NONE`]); older entries of `v` go stale. An older key
+    /// with the same cost is not told apart: it pops next to the current
+    /// one (equal keys) and stands for it, and the one popped later is
+    /// judged against whatever `v` has queued by then.
     fn queue(&mut self, v: u32, cost: f32, target: u32) {
         self.queued[v as usize] = (cost, target);
-        let version = &mut self.version[v as usize];
-        *version = version.wrapping_add(1);
         if target != NONE {
-            self.heap.push(Entry {
-                cost,
-                vertex: v,
-                target,
-                stamp: *version,
-            });
+            self.heap.push(key(cost, v));
         }
     }
 
@@ -408,7 +370,7 @@ impl Contractor {
                     Some(self.stop_record(StopReason::TargetReached, RoundStats::default()));
                 return;
             }
-            let Some(e) = self.heap.pop() else {
+            let Some(k) = self.heap.pop() else {
                 // A round ends. Refused pairs may have become valid since
                 // (a guard looks at more than the two vertices' own
                 // neighbourhoods); try everything again unless the round
@@ -422,8 +384,9 @@ impl Contractor {
                 round = RoundStats::default();
                 continue;
             };
-            let (a, b) = (e.vertex, e.target);
-            if self.removed[a as usize] || self.version[a as usize] != e.stamp {
+            let a = k as u32;
+            let (cost, b) = self.queued[a as usize];
+            if self.removed[a as usize] || b == NONE || cost_bits(cost) != (k >> 32) as u32 {
                 continue;
             }
             if self.removed[b as usize] {
@@ -434,7 +397,7 @@ impl Contractor {
             }
             let target = self.target_position(a, b);
             match self.check(a, b, target) {
-                Ok(()) => self.contract(a, b, target, e.cost),
+                Ok(()) => self.contract(a, b, target, cost),
                 Err(why) => {
                     round.candidates += 1;
                     match why {
@@ -622,7 +585,6 @@ impl Contractor {
                 self.quadrics.push(Quadric::default());
                 self.vertex_tris.push(Vec::new());
                 self.removed.push(false);
-                self.version.push(0);
                 self.mark.push(0);
                 self.queued.push((f32::NAN, NONE));
                 self.blocked.push(Vec::new());
@@ -691,8 +653,7 @@ impl Contractor {
         self.removed[a as usize] = true;
         // Entries of removed vertices are skipped by `removed`; the
         // survivor is refreshed below, which replaces its entry only when
-        // its choice changed (bumping its version here would drop it from
-        // the queue whenever the choice stayed the same).
+        // its choice changed (its key then stays current).
         for gone in [a, b] {
             if gone != survivor {
                 self.forget_refusals(gone);
