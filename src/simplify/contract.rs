@@ -11,9 +11,11 @@
 //!   diagonal, as a running maximum so it never decreases.
 //! - **One queue entry per vertex**: its cheapest allowed target. The
 //!   queue (`queue.rs`) holds 8-byte `(cost, vertex)` keys; the vertex's
-//!   current cost and target live beside it, and a popped key whose cost is
-//!   no longer the vertex's is stale. After `a → b` the survivor and `a`'s
-//!   neighbours choose again; `b`'s other neighbours keep their choice.
+//!   current cost and target live beside it. A cost that rises pushes
+//!   nothing: the older, lower key pops first and is pushed again at the
+//!   current cost, so the pop order is that of an exact priority queue.
+//!   After `a → b` the survivor and `a`'s neighbours choose again; `b`'s
+//!   other neighbours keep their choice.
 //! - **A refused target is remembered per vertex** until its
 //!   neighbourhood changes, and the vertex picks its next best. Validity
 //!   can also change farther away, so when the queue runs dry every refusal
@@ -60,6 +62,9 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     c.finish()
 }
 
+/// No key in [`Contractor::floor`].
+const NO_KEY: u32 = u32::MAX;
+
 /// "No target" in [`Contractor::queued`].
 const NONE: u32 = u32::MAX;
 
@@ -91,11 +96,17 @@ struct Contractor {
     /// Scratch marks per vertex, compared with `epoch`.
     mark: Vec<u32>,
     epoch: u32,
-    /// One key per [`Contractor::queue`] call; a key is current while its
-    /// cost equals the vertex's queued cost (older ones are skipped).
+    /// `(cost, vertex)` keys. A vertex's choice is current when a key with
+    /// its queued cost pops; a key below it is pushed again at that cost
+    /// (costs mostly rise, so most updates push nothing), one above it is
+    /// stale. Invariant: every queued vertex has a key at or below its
+    /// queued cost.
     heap: Queue,
     /// The (cost, target) of each vertex's current queue entry.
     queued: Vec<(f32, u32)>,
+    /// `cost_bits` of the lowest key of each vertex known to be in `heap`
+    /// ([`NO_KEY`] when none may be).
+    floor: Vec<u32>,
     /// Targets a guard refused for each vertex since its neighbourhood last
     /// changed; `blocked_count` counts them all.
     blocked: Vec<Vec<u32>>,
@@ -209,6 +220,7 @@ impl Contractor {
             epoch: 0,
             heap: Queue::with_capacity(2 * n),
             queued: vec![(f32::NAN, NONE); n],
+            floor: vec![NO_KEY; n],
             blocked: vec![Vec::new(); n],
             blocked_count: 0,
             ring: Vec::new(),
@@ -297,14 +309,17 @@ impl Contractor {
         }
     }
 
-    /// Makes `v → target` at `cost` the vertex's one current entry (no
-    /// entry for [`NONE`]); older entries of `v` go stale. An older key
-    /// with the same cost is not told apart: it pops next to the current
-    /// one (equal keys) and stands for it, and the one popped later is
-    /// judged against whatever `v` has queued by then.
+    /// Makes `v → target` at `cost` the vertex's one current entry (none
+    /// for [`NONE`]). A key is pushed only when `cost` is below every key
+    /// `v` has in the queue; otherwise the lowest one pops first and is
+    /// pushed again at the then queued cost (see [`Contractor::heap`]).
+    /// Keys are not told apart by target: equal keys pop together and the
+    /// first stands for the current choice.
     fn queue(&mut self, v: u32, cost: f32, target: u32) {
         self.queued[v as usize] = (cost, target);
-        if target != NONE {
+        let bits = cost_bits(cost);
+        if target != NONE && bits < self.floor[v as usize] {
+            self.floor[v as usize] = bits;
             self.heap.push(key(cost, v));
         }
     }
@@ -385,8 +400,19 @@ impl Contractor {
                 continue;
             };
             let a = k as u32;
+            // Other keys of `a` may remain, but none lower.
+            self.floor[a as usize] = NO_KEY;
             let (cost, b) = self.queued[a as usize];
-            if self.removed[a as usize] || b == NONE || cost_bits(cost) != (k >> 32) as u32 {
+            if self.removed[a as usize] || b == NONE {
+                continue;
+            }
+            let (popped, bits) = ((k >> 32) as u32, cost_bits(cost));
+            if popped != bits {
+                if popped < bits {
+                    // The cost rose since this key: queue it where it is now.
+                    self.floor[a as usize] = bits;
+                    self.heap.push(key(cost, a));
+                }
                 continue;
             }
             if self.removed[b as usize] {
@@ -418,6 +444,7 @@ impl Contractor {
             self.forget_refusals(v);
             if !self.removed[v as usize] {
                 self.queued[v as usize] = (f32::NAN, NONE);
+                self.floor[v as usize] = NO_KEY;
                 self.refresh(v);
             }
         }
@@ -587,6 +614,7 @@ impl Contractor {
                 self.removed.push(false);
                 self.mark.push(0);
                 self.queued.push((f32::NAN, NONE));
+                self.floor.push(NO_KEY);
                 self.blocked.push(Vec::new());
                 if !self.partners.is_empty() {
                     self.partners.push(Vec::new());
