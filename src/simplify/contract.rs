@@ -62,6 +62,9 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     c.finish()
 }
 
+/// A triangle that died, in [`Contractor::tris`].
+const DEAD: u32 = u32::MAX;
+
 /// No key in [`Contractor::floor`].
 const NO_KEY: u32 = u32::MAX;
 
@@ -82,9 +85,9 @@ struct Contractor {
     pos: Vec<DVec3>,
     quadrics: Vec<Quadric>,
     /// Current triangles (input triangles with contracted vertices
-    /// substituted) and whether they still have three distinct vertices.
+    /// substituted); `[DEAD; 3]` once a contraction left them without three
+    /// distinct vertices (no separate flag to load).
     tris: Vec<[u32; 3]>,
-    alive: Vec<bool>,
     /// Unit normal of each input triangle (zero for a zero-area one).
     normals0: Vec<DVec3>,
     /// Triangles around each vertex; may hold dead ones until the vertex is
@@ -210,7 +213,6 @@ impl Contractor {
             diagonal,
             pos,
             quadrics,
-            alive: vec![true; tris.len()],
             tris,
             normals0,
             vertex_tris,
@@ -244,7 +246,7 @@ impl Contractor {
         let epoch = self.next_epoch();
         let list = std::mem::take(&mut self.vertex_tris[v as usize]);
         for &t in &list {
-            if !self.alive[t as usize] {
+            if self.tris[t as usize][0] == DEAD {
                 continue;
             }
             for w in self.tris[t as usize] {
@@ -278,6 +280,9 @@ impl Contractor {
     /// The cheapest target of `v` among its neighbours and virtual
     /// partners that no guard refused yet: `(cost, target)`.
     fn best(&mut self, v: u32) -> Option<(f64, u32)> {
+        if self.placement == Placement::Endpoint {
+            return self.best_endpoint(v);
+        }
         let mut best: Option<(f64, u32)> = None;
         let blocked = std::mem::take(&mut self.blocked[v as usize]);
         self.for_each_partner(v, |c, w| {
@@ -293,12 +298,49 @@ impl Contractor {
         best
     }
 
+    /// [`Contractor::best`] in endpoint mode, the hot path: `v`'s quadric is
+    /// loaded once, and neighbours are not deduplicated (each is seen once
+    /// per shared triangle; the choice does not depend on repeats).
+    fn best_endpoint(&self, v: u32) -> Option<(f64, u32)> {
+        let q = &self.quadrics[v as usize];
+        let blocked = &self.blocked[v as usize];
+        let mut best: Option<(f64, u32)> = None;
+        let mut consider = |w: u32| {
+            if blocked.contains(&w) {
+                return;
+            }
+            let cost = q.mean_error(self.pos[w as usize]);
+            if best.is_none_or(|(bc, bw)| cost < bc || (cost == bc && w < bw)) {
+                best = Some((cost, w));
+            }
+        };
+        for &t in &self.vertex_tris[v as usize] {
+            let tri = self.tris[t as usize];
+            if tri[0] == DEAD {
+                continue;
+            }
+            for w in tri {
+                if w != v {
+                    consider(w);
+                }
+            }
+        }
+        if let Some(partners) = self.partners.get(v as usize) {
+            for &w in partners {
+                if !self.removed[w as usize] {
+                    consider(w);
+                }
+            }
+        }
+        best
+    }
+
     /// Recomputes `v`'s cheapest contraction and queues it when it changed
     /// (the old entry then goes stale).
     fn refresh(&mut self, v: u32) {
         // Drop the triangles that died around `v` while it stayed.
         let mut list = std::mem::take(&mut self.vertex_tris[v as usize]);
-        list.retain(|&t| self.alive[t as usize]);
+        list.retain(|&t| self.tris[t as usize][0] != DEAD);
         self.vertex_tris[v as usize] = list;
         let new = self
             .best(v)
@@ -485,7 +527,7 @@ impl Contractor {
         let apex = epoch + 1;
         // Mark a's neighbours.
         for &t in &self.vertex_tris[a as usize] {
-            if self.alive[t as usize] {
+            if self.tris[t as usize][0] != DEAD {
                 for w in self.tris[t as usize] {
                     self.mark[w as usize] = epoch;
                 }
@@ -495,7 +537,7 @@ impl Contractor {
         // neighbours.
         for &t in &self.vertex_tris[b as usize] {
             let tri = self.tris[t as usize];
-            if self.alive[t as usize] && tri.contains(&a) {
+            if self.tris[t as usize][0] != DEAD && tri.contains(&a) {
                 for w in tri {
                     if w != a && w != b {
                         self.mark[w as usize] = apex;
@@ -505,7 +547,7 @@ impl Contractor {
         }
         for &t in &self.vertex_tris[b as usize] {
             let tri = self.tris[t as usize];
-            if self.alive[t as usize]
+            if self.tris[t as usize][0] != DEAD
                 && !tri.contains(&a)
                 && tri
                     .iter()
@@ -518,7 +560,7 @@ impl Contractor {
         // no flipped normal.
         for &t in &self.vertex_tris[a as usize] {
             let tri = self.tris[t as usize];
-            if !self.alive[t as usize] || tri.contains(&b) {
+            if self.tris[t as usize][0] == DEAD || tri.contains(&b) {
                 continue;
             }
             let others = tri.map(|w| w != a && self.mark[w as usize] == apex);
@@ -532,7 +574,7 @@ impl Contractor {
         if self.placement == Placement::Optimal {
             for &t in &self.vertex_tris[b as usize] {
                 let tri = self.tris[t as usize];
-                if self.alive[t as usize] && !tri.contains(&a) && self.flips(t, b, target) {
+                if self.tris[t as usize][0] != DEAD && !tri.contains(&a) && self.flips(t, b, target) {
                     return Err(Reject::Flip);
                 }
             }
@@ -546,7 +588,7 @@ impl Contractor {
         let mut counts = std::mem::take(&mut self.scratch);
         counts.clear();
         for &t in &self.vertex_tris[v as usize] {
-            if !self.alive[t as usize] {
+            if self.tris[t as usize][0] == DEAD {
                 continue;
             }
             for x in self.tris[t as usize] {
@@ -570,7 +612,7 @@ impl Contractor {
     fn has_triangle_on(&self, b: u32, tri: [u32; 3], a: u32) -> bool {
         let want = tri.map(|w| if w == a { b } else { w });
         self.vertex_tris[b as usize].iter().any(|&u| {
-            self.alive[u as usize] && want.iter().all(|w| self.tris[u as usize].contains(w))
+            self.tris[u as usize][0] != DEAD && want.iter().all(|w| self.tris[u as usize].contains(w))
         })
     }
 
@@ -629,12 +671,12 @@ impl Contractor {
         let mut merged = std::mem::take(&mut self.vertex_tris[b as usize]);
         let mut dead = 0u32;
         merged.retain(|&t| {
-            if !self.alive[t as usize] {
+            if self.tris[t as usize][0] == DEAD {
                 return false;
             }
             let tri = &mut self.tris[t as usize];
             if tri.contains(&a) {
-                self.alive[t as usize] = false;
+                *tri = [DEAD; 3];
                 dead += 1;
                 return false;
             }
@@ -647,7 +689,7 @@ impl Contractor {
         });
         let from_a = std::mem::take(&mut self.vertex_tris[a as usize]);
         for &t in &from_a {
-            if !self.alive[t as usize] {
+            if self.tris[t as usize][0] == DEAD {
                 continue;
             }
             for w in self.tris[t as usize].iter_mut() {
@@ -735,8 +777,8 @@ impl Contractor {
     fn stop_record(&mut self, reason: StopReason, round: RoundStats) -> Stop {
         let epoch = self.next_epoch();
         let mut vertices = 0;
-        for (t, tri) in self.tris.iter().enumerate() {
-            if self.alive[t] {
+        for tri in &self.tris {
+            if tri[0] != DEAD {
                 for &w in tri {
                     if self.mark[w as usize] != epoch {
                         self.mark[w as usize] = epoch;
