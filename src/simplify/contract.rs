@@ -42,7 +42,9 @@ use super::pairs::{vertex_triangles, virtual_pairs};
 use super::quadric::Quadric;
 use super::queue::{cost_bits, key, Queue};
 use super::{Placement, Simplification, SimplifyOptions, Stop, StopReason};
-use crate::mesh::{Mesh, TriangleAdjacency, NO_NEIGHBOUR};
+use crate::mesh::Mesh;
+#[cfg(doc)]
+use crate::mesh::TriangleAdjacency;
 use glam::DVec3;
 
 /// Computes the whole contraction sequence of `mesh`.
@@ -159,14 +161,14 @@ impl Contractor {
             };
             normals0.push(normal);
         }
+        let vertex_tris = vertex_triangles(n, &tris);
         if options.boundary_weight > 0.0 {
-            let adjacency = TriangleAdjacency::new(mesh);
             for (t, tri) in tris.iter().enumerate() {
                 for slot in 0..3 {
-                    if adjacency.neighbours[t][slot] != NO_NEIGHBOUR {
+                    let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
+                    if !is_border(&tris, &vertex_tris[a as usize], t as u32, a, b) {
                         continue;
                     }
-                    let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
                     let (pa, pb) = (pos[a as usize], pos[b as usize]);
                     let edge = pb - pa;
                     let normal = edge.cross(normals0[t]).normalize_or_zero();
@@ -194,7 +196,6 @@ impl Contractor {
                 }
             }
         }
-        let vertex_tris = vertex_triangles(n, &tris);
         let diagonal = f64::from(mesh.diagonal()).max(f64::MIN_POSITIVE);
         let mut partners = Vec::new();
         if let Some(d) = options.pair_distance {
@@ -810,10 +811,66 @@ impl Contractor {
     }
 }
 
+/// Whether the directed edge `(a, b)` of triangle `t` has no
+/// orientation-consistent neighbour as [`TriangleAdjacency`] pairs them (the
+/// `r`-th holder of `(a, b)` with the `r`-th holder of `(b, a)`, in triangle
+/// order), read from the triangles `around_a` of `a` (in increasing order)
+/// without building the whole adjacency.
+fn is_border(tris: &[[u32; 3]], around_a: &[u32], t: u32, a: u32, b: u32) -> bool {
+    let (mut rank, mut opposite) = (0u32, 0u32);
+    for &u in around_a {
+        let tri = tris[u as usize];
+        let k = tri.iter().position(|&w| w == a).unwrap_or(0);
+        if tri[(k + 1) % 3] == b && u < t {
+            rank += 1;
+        } else if tri[(k + 2) % 3] == b {
+            opposite += 1;
+        }
+    }
+    rank >= opposite
+}
+
 /// Rejections counted over one round of the queue.
 #[derive(Default, Clone, Copy)]
 struct RoundStats {
     candidates: usize,
     flip: usize,
     topology: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{TriangleAdjacency, NO_NEIGHBOUR};
+
+    /// `is_border` marks exactly the edge slots without a neighbour in
+    /// [`TriangleAdjacency`], fins and flipped triangles included.
+    #[test]
+    fn border_slots_match_the_adjacency() {
+        let grid: crate::mesh::generate::Generated = "grid:200".parse().unwrap();
+        let mut mesh = grid.build();
+        // A fin (three triangles on one edge), a flipped triangle and a
+        // lone one.
+        let [a, b] = [mesh.triangles[0][0], mesh.triangles[0][1]];
+        let extra = mesh.positions.len() as u32;
+        mesh.positions.push(glam::Vec3::new(0.3, 0.3, 1.0));
+        mesh.positions.push(glam::Vec3::new(0.5, 0.1, 2.0));
+        let [x, y, z] = mesh.triangles[5];
+        mesh.triangles.push([a, b, extra]);
+        mesh.triangles.push([b, a, extra + 1]);
+        mesh.triangles.push([y, x, extra + 1]);
+        mesh.triangles.push([x, z, extra]);
+        let adjacency = TriangleAdjacency::new(&mesh);
+        let around = vertex_triangles(mesh.positions.len(), &mesh.triangles);
+        let mut borders = 0;
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for slot in 0..3 {
+                let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
+                let border = is_border(&mesh.triangles, &around[a as usize], t as u32, a, b);
+                assert_eq!(border, adjacency.neighbours[t][slot] == NO_NEIGHBOUR);
+                borders += usize::from(border);
+            }
+        }
+        assert!(borders > 10);
+    }
 }
