@@ -45,7 +45,7 @@ use super::{Placement, Simplification, SimplifyOptions, Stop, StopReason};
 use crate::mesh::Mesh;
 #[cfg(doc)]
 use crate::mesh::TriangleAdjacency;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 /// Computes the whole contraction sequence of `mesh`.
 ///
@@ -84,14 +84,19 @@ struct Contractor {
     placement: Placement,
     diagonal: f64,
     /// Positions, `f64`; optimal mode appends one per contraction.
-    pos: Vec<DVec3>,
+    /// Input positions as loaded (`f32`, half the cache footprint; widened
+    /// exactly on use, see [`Contractor::p`]).
+    pos: Vec<Vec3>,
+    /// Positions of the vertices optimal mode appends (`f64`, after `pos`).
+    appended_pos: Vec<DVec3>,
     quadrics: Vec<Quadric>,
     /// Current triangles (input triangles with contracted vertices
     /// substituted); `[DEAD; 3]` once a contraction left them without three
     /// distinct vertices (no separate flag to load).
     tris: Vec<[u32; 3]>,
-    /// Unit normal of each input triangle (zero for a zero-area one).
-    normals0: Vec<DVec3>,
+    /// Unnormalised `f32` normal (edge cross product) of each input
+    /// triangle, zero for a zero-area one; see [`Contractor::input_normal`].
+    normals0: Vec<Vec3>,
     /// Triangles around each vertex; may hold dead ones until the vertex is
     /// next contracted.
     vertex_tris: Vec<Vec<u32>>,
@@ -121,7 +126,7 @@ struct Contractor {
     /// Output.
     steps: Vec<Collapse>,
     triangle_counts: Vec<u32>,
-    appended: Vec<glam::Vec3>,
+    appended: Vec<Vec3>,
     triangles_now: u32,
     max_error: f32,
     stop: Option<Stop>,
@@ -133,7 +138,7 @@ struct Contractor {
 impl Contractor {
     fn new(mesh: &Mesh, options: &SimplifyOptions) -> Contractor {
         let n = mesh.vertex_count();
-        let pos: Vec<DVec3> = mesh.positions.iter().map(|p| p.as_dvec3()).collect();
+        let pos = mesh.positions.clone();
         let tris = mesh.triangles.clone();
         for t in &tris {
             assert!(
@@ -155,9 +160,9 @@ impl Contractor {
                     for &v in t {
                         quadrics[v as usize] += q;
                     }
-                    (p1 - p0).cross(p2 - p0).as_dvec3().normalize_or_zero()
+                    (p1 - p0).cross(p2 - p0)
                 }
-                None => DVec3::ZERO,
+                None => Vec3::ZERO,
             };
             normals0.push(normal);
         }
@@ -169,9 +174,11 @@ impl Contractor {
                     if !is_border(&tris, &vertex_tris[a as usize], t as u32, a, b) {
                         continue;
                     }
-                    let (pa, pb) = (pos[a as usize], pos[b as usize]);
+                    let (pa, pb) = (pos[a as usize].as_dvec3(), pos[b as usize].as_dvec3());
                     let edge = pb - pa;
-                    let normal = edge.cross(normals0[t]).normalize_or_zero();
+                    let normal = edge
+                        .cross(normals0[t].as_dvec3().normalize_or_zero())
+                        .normalize_or_zero();
                     if normal == DVec3::ZERO {
                         continue;
                     }
@@ -216,6 +223,7 @@ impl Contractor {
             quadrics,
             tris,
             normals0,
+            appended_pos: Vec::new(),
             vertex_tris,
             partners,
             removed: vec![false; n],
@@ -240,6 +248,22 @@ impl Contractor {
             c.refresh(v);
         }
         c
+    }
+
+    /// Position of vertex `v` in `f64` (input positions widen exactly).
+    #[inline]
+    fn p(&self, v: u32) -> DVec3 {
+        match self.pos.get(v as usize) {
+            Some(p) => p.as_dvec3(),
+            None => self.appended_pos[v as usize - self.pos.len()],
+        }
+    }
+
+    /// Unit normal of input triangle `t` (zero for a zero-area one),
+    /// normalised in `f64` as when it was stored that way.
+    #[inline]
+    fn input_normal(&self, t: u32) -> DVec3 {
+        self.normals0[t as usize].as_dvec3().normalize_or_zero()
     }
 
     /// Calls `f` once for every current neighbour or virtual partner of `v`.
@@ -310,7 +334,7 @@ impl Contractor {
             if blocked.contains(&w) {
                 return;
             }
-            let cost = q.mean_error(self.pos[w as usize]);
+            let cost = q.mean_error(self.p(w));
             if best.is_none_or(|(bc, bw)| cost < bc || (cost == bc && w < bw)) {
                 best = Some((cost, w));
             }
@@ -403,12 +427,12 @@ impl Contractor {
     /// meshoptimizer's Hausdorff on `ogre` at 10%), and the mean (not the
     /// area-weighted sum) keeps large flat regions from looking expensive.
     fn cost(&self, removed: u32, kept: u32) -> f64 {
-        self.quadrics[removed as usize].mean_error(self.pos[kept as usize])
+        self.quadrics[removed as usize].mean_error(self.p(kept))
     }
 
     /// The quadric's minimiser, or the best of the endpoints and midpoint.
     fn optimal_point(&self, q: &Quadric, a: u32, b: u32) -> (DVec3, f64) {
-        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let (pa, pb) = (self.p(a), self.p(b));
         let mut best = (pb, q.mean_error(pb));
         for p in [pa, 0.5 * (pa + pb)].into_iter().chain(q.minimizer()) {
             let cost = q.mean_error(p);
@@ -483,7 +507,7 @@ impl Contractor {
 
     /// Forgets every refusal and queues every live vertex again.
     fn requeue_all(&mut self) {
-        for v in 0..self.pos.len() as u32 {
+        for v in 0..self.removed.len() as u32 {
             self.forget_refusals(v);
             if !self.removed[v as usize] {
                 self.queued[v as usize] = (f32::NAN, NONE);
@@ -496,7 +520,7 @@ impl Contractor {
     /// Where the surviving vertex of `a → b` goes.
     fn target_position(&self, a: u32, b: u32) -> DVec3 {
         match self.placement {
-            Placement::Endpoint => self.pos[b as usize],
+            Placement::Endpoint => self.p(b),
             Placement::Optimal => {
                 let q = self.quadrics[a as usize] + self.quadrics[b as usize];
                 self.optimal_point(&q, a, b).0
@@ -622,11 +646,11 @@ impl Contractor {
     /// without area.
     fn flips(&self, t: u32, v: u32, p: DVec3) -> bool {
         let tri = self.tris[t as usize];
-        let [p0, p1, p2] = tri.map(|w| self.pos[w as usize]);
+        let [p0, p1, p2] = tri.map(|w| self.p(w));
         let now = (p1 - p0).cross(p2 - p0);
-        let [q0, q1, q2] = tri.map(|w| if w == v { p } else { self.pos[w as usize] });
+        let [q0, q1, q2] = tri.map(|w| if w == v { p } else { self.p(w) });
         let next = (q1 - q0).cross(q2 - q0);
-        let input = self.normals0[t as usize];
+        let input = self.input_normal(t);
         // cos 75°: a pure 90° test lets a triangle fold over through a
         // series of near-90° turns (meshoptimizer makes the same choice).
         let limit = 0.25 * next.length();
@@ -650,8 +674,8 @@ impl Contractor {
         let survivor = match self.placement {
             Placement::Endpoint => b,
             Placement::Optimal => {
-                let c = self.pos.len() as u32;
-                self.pos.push(target);
+                let c = self.removed.len() as u32;
+                self.appended_pos.push(target);
                 self.quadrics.push(Quadric::default());
                 self.vertex_tris.push(Vec::new());
                 self.removed.push(false);
