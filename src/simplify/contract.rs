@@ -168,12 +168,13 @@ impl Contractor {
         }
         let vertex_tris = vertex_triangles(n, &tris);
         if options.boundary_weight > 0.0 {
+            let borders = border_slots(&tris, &vertex_tris);
             for (t, tri) in tris.iter().enumerate() {
                 for slot in 0..3 {
-                    let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
-                    if !is_border(&tris, &vertex_tris[a as usize], t as u32, a, b) {
+                    if borders[t] & (1 << slot) == 0 {
                         continue;
                     }
+                    let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
                     let (pa, pb) = (pos[a as usize].as_dvec3(), pos[b as usize].as_dvec3());
                     let edge = pb - pa;
                     let normal = edge
@@ -835,6 +836,46 @@ impl Contractor {
     }
 }
 
+/// For each triangle, bit `slot` set when [`is_border`] holds for that
+/// edge slot. Works vertex by vertex on a local copy of the corners (the
+/// triangles around `a` read once, not once per slot).
+fn border_slots(tris: &[[u32; 3]], vertex_tris: &[Vec<u32>]) -> Vec<u8> {
+    const LOCAL: usize = 32;
+    let mut out = vec![0u8; tris.len()];
+    for (a, around) in vertex_tris.iter().enumerate() {
+        let a = a as u32;
+        if around.len() > LOCAL {
+            for &t in around {
+                let tri = tris[t as usize];
+                let k = tri.iter().position(|&w| w == a).unwrap_or(0);
+                if is_border(tris, around, t, a, tri[(k + 1) % 3]) {
+                    out[t as usize] |= 1 << k;
+                }
+            }
+            continue;
+        }
+        // Corners around `a`: the vertex after and before it, and its slot.
+        let (mut next, mut prev, mut slot) = ([0u32; LOCAL], [0u32; LOCAL], [0u8; LOCAL]);
+        for (i, &t) in around.iter().enumerate() {
+            let tri = tris[t as usize];
+            let k = tri.iter().position(|&w| w == a).unwrap_or(0);
+            (next[i], prev[i], slot[i]) = (tri[(k + 1) % 3], tri[(k + 2) % 3], k as u8);
+        }
+        let k = around.len();
+        for i in 0..k {
+            let b = next[i];
+            // `around` is in increasing triangle order: earlier holders of
+            // (a, b) come first.
+            let rank = next[..i].iter().filter(|&&x| x == b).count();
+            let opposite = prev[..k].iter().filter(|&&x| x == b).count();
+            if rank >= opposite {
+                out[around[i] as usize] |= 1 << slot[i];
+            }
+        }
+    }
+    out
+}
+
 /// Whether the directed edge `(a, b)` of triangle `t` has no
 /// orientation-consistent neighbour as [`TriangleAdjacency`] pairs them (the
 /// `r`-th holder of `(a, b)` with the `r`-th holder of `(b, a)`, in triangle
@@ -886,12 +927,14 @@ mod tests {
         mesh.triangles.push([x, z, extra]);
         let adjacency = TriangleAdjacency::new(&mesh);
         let around = vertex_triangles(mesh.positions.len(), &mesh.triangles);
+        let slots = border_slots(&mesh.triangles, &around);
         let mut borders = 0;
         for (t, tri) in mesh.triangles.iter().enumerate() {
             for slot in 0..3 {
                 let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
                 let border = is_border(&mesh.triangles, &around[a as usize], t as u32, a, b);
                 assert_eq!(border, adjacency.neighbours[t][slot] == NO_NEIGHBOUR);
+                assert_eq!(border, slots[t] & (1 << slot) != 0);
                 borders += usize::from(border);
             }
         }
