@@ -9,10 +9,13 @@
 //!   [`Contractor::cost`]); face planes weigh `sqrt(area)`. The recorded
 //!   error is the square root of that cost relative to the bounding-box
 //!   diagonal, as a running maximum so it never decreases.
-//! - **One queue entry per vertex**: its cheapest allowed target, stamped
-//!   with a per-vertex version; refreshing a vertex bumps the version, so
-//!   older entries go stale. After `a → b` the survivor and `a`'s
-//!   neighbours choose again; `b`'s other neighbours keep their choice.
+//! - **One queue entry per vertex**: its cheapest allowed target. The
+//!   queue (`queue.rs`) holds 8-byte `(cost, vertex)` keys; the vertex's
+//!   current cost and target live beside it. A cost that rises pushes
+//!   nothing: the older, lower key pops first and is pushed again at the
+//!   current cost, so the pop order is that of an exact priority queue.
+//!   After `a → b` the survivor and `a`'s neighbours choose again; `b`'s
+//!   other neighbours keep their choice.
 //! - **A refused target is remembered per vertex** until its
 //!   neighbourhood changes, and the vertex picks its next best. Validity
 //!   can also change farther away, so when the queue runs dry every refusal
@@ -37,11 +40,12 @@
 use super::collapses::{Collapse, Collapses};
 use super::pairs::{vertex_triangles, virtual_pairs};
 use super::quadric::Quadric;
+use super::queue::{cost_bits, key, Queue};
 use super::{Placement, Simplification, SimplifyOptions, Stop, StopReason};
-use crate::mesh::{Mesh, TriangleAdjacency, NO_NEIGHBOUR};
-use glam::DVec3;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+use crate::mesh::Mesh;
+#[cfg(doc)]
+use crate::mesh::TriangleAdjacency;
+use glam::{DVec3, Vec3};
 
 /// Computes the whole contraction sequence of `mesh`.
 ///
@@ -60,42 +64,14 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     c.finish()
 }
 
-/// A queue entry: the cheapest allowed contraction of `vertex` (into
-/// `target`, or both into a new vertex in optimal mode) at cost `cost`.
-#[derive(Clone, Copy)]
-struct Entry {
-    cost: f32,
-    vertex: u32,
-    target: u32,
-    /// `version[vertex]` when queued: the entry is current while it holds.
-    stamp: u32,
-}
+/// A triangle that died, in [`Contractor::tris`].
+const DEAD: u32 = u32::MAX;
+
+/// No key in [`Contractor::floor`].
+const NO_KEY: u32 = u32::MAX;
 
 /// "No target" in [`Contractor::queued`].
 const NONE: u32 = u32::MAX;
-
-impl PartialEq for Entry {
-    fn eq(&self, other: &Entry) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Entry) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Entry {
-    /// Reversed on cost, so the max-heap pops the cheapest; ties broken by
-    /// vertex indices so the sequence is deterministic.
-    fn cmp(&self, other: &Entry) -> Ordering {
-        other
-            .cost
-            .total_cmp(&self.cost)
-            .then(other.vertex.cmp(&self.vertex))
-            .then(other.target.cmp(&self.target))
-    }
-}
 
 /// Why a guard refused a contraction.
 enum Reject {
@@ -108,27 +84,39 @@ struct Contractor {
     placement: Placement,
     diagonal: f64,
     /// Positions, `f64`; optimal mode appends one per contraction.
-    pos: Vec<DVec3>,
+    /// Input positions as loaded (`f32`, half the cache footprint; widened
+    /// exactly on use, see [`Contractor::p`]).
+    pos: Vec<Vec3>,
+    /// Positions of the vertices optimal mode appends (`f64`, after `pos`).
+    appended_pos: Vec<DVec3>,
     quadrics: Vec<Quadric>,
     /// Current triangles (input triangles with contracted vertices
-    /// substituted) and whether they still have three distinct vertices.
+    /// substituted); `[DEAD; 3]` once a contraction left them without three
+    /// distinct vertices (no separate flag to load).
     tris: Vec<[u32; 3]>,
-    alive: Vec<bool>,
-    /// Unit normal of each input triangle (zero for a zero-area one).
-    normals0: Vec<DVec3>,
+    /// Unnormalised `f32` normal (edge cross product) of each input
+    /// triangle, zero for a zero-area one; see [`Contractor::input_normal`].
+    normals0: Vec<Vec3>,
     /// Triangles around each vertex; may hold dead ones until the vertex is
     /// next contracted.
     vertex_tris: Vec<Vec<u32>>,
     /// Virtual partners of each vertex (empty unless enabled).
     partners: Vec<Vec<u32>>,
     removed: Vec<bool>,
-    version: Vec<u32>,
     /// Scratch marks per vertex, compared with `epoch`.
     mark: Vec<u32>,
     epoch: u32,
-    heap: BinaryHeap<Entry>,
+    /// `(cost, vertex)` keys. A vertex's choice is current when a key with
+    /// its queued cost pops; a key below it is pushed again at that cost
+    /// (costs mostly rise, so most updates push nothing), one above it is
+    /// stale. Invariant: every queued vertex has a key at or below its
+    /// queued cost.
+    heap: Queue,
     /// The (cost, target) of each vertex's current queue entry.
     queued: Vec<(f32, u32)>,
+    /// `cost_bits` of the lowest key of each vertex known to be in `heap`
+    /// ([`NO_KEY`] when none may be).
+    floor: Vec<u32>,
     /// Targets a guard refused for each vertex since its neighbourhood last
     /// changed; `blocked_count` counts them all.
     blocked: Vec<Vec<u32>>,
@@ -138,7 +126,7 @@ struct Contractor {
     /// Output.
     steps: Vec<Collapse>,
     triangle_counts: Vec<u32>,
-    appended: Vec<glam::Vec3>,
+    appended: Vec<Vec3>,
     triangles_now: u32,
     max_error: f32,
     stop: Option<Stop>,
@@ -150,7 +138,7 @@ struct Contractor {
 impl Contractor {
     fn new(mesh: &Mesh, options: &SimplifyOptions) -> Contractor {
         let n = mesh.vertex_count();
-        let pos: Vec<DVec3> = mesh.positions.iter().map(|p| p.as_dvec3()).collect();
+        let pos = mesh.positions.clone();
         let tris = mesh.triangles.clone();
         for t in &tris {
             assert!(
@@ -172,23 +160,26 @@ impl Contractor {
                     for &v in t {
                         quadrics[v as usize] += q;
                     }
-                    (p1 - p0).cross(p2 - p0).as_dvec3().normalize_or_zero()
+                    (p1 - p0).cross(p2 - p0)
                 }
-                None => DVec3::ZERO,
+                None => Vec3::ZERO,
             };
             normals0.push(normal);
         }
+        let vertex_tris = vertex_triangles(n, &tris);
         if options.boundary_weight > 0.0 {
-            let adjacency = TriangleAdjacency::new(mesh);
+            let borders = border_slots(&tris, &vertex_tris);
             for (t, tri) in tris.iter().enumerate() {
                 for slot in 0..3 {
-                    if adjacency.neighbours[t][slot] != NO_NEIGHBOUR {
+                    if borders[t] & (1 << slot) == 0 {
                         continue;
                     }
                     let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
-                    let (pa, pb) = (pos[a as usize], pos[b as usize]);
+                    let (pa, pb) = (pos[a as usize].as_dvec3(), pos[b as usize].as_dvec3());
                     let edge = pb - pa;
-                    let normal = edge.cross(normals0[t]).normalize_or_zero();
+                    let normal = edge
+                        .cross(normals0[t].as_dvec3().normalize_or_zero())
+                        .normalize_or_zero();
                     if normal == DVec3::ZERO {
                         continue;
                     }
@@ -213,7 +204,6 @@ impl Contractor {
                 }
             }
         }
-        let vertex_tris = vertex_triangles(n, &tris);
         let diagonal = f64::from(mesh.diagonal()).max(f64::MIN_POSITIVE);
         let mut partners = Vec::new();
         if let Some(d) = options.pair_distance {
@@ -232,17 +222,17 @@ impl Contractor {
             diagonal,
             pos,
             quadrics,
-            alive: vec![true; tris.len()],
             tris,
             normals0,
+            appended_pos: Vec::new(),
             vertex_tris,
             partners,
             removed: vec![false; n],
-            version: vec![0; n],
             mark: vec![0; n],
             epoch: 0,
-            heap: BinaryHeap::new(),
+            heap: Queue::with_capacity(2 * n),
             queued: vec![(f32::NAN, NONE); n],
+            floor: vec![NO_KEY; n],
             blocked: vec![Vec::new(); n],
             blocked_count: 0,
             ring: Vec::new(),
@@ -261,12 +251,36 @@ impl Contractor {
         c
     }
 
+    /// Asks for the triangles around `v` ahead of the loops over them.
+    #[inline]
+    fn prefetch_ring(&self, v: u32) {
+        for &t in &self.vertex_tris[v as usize] {
+            prefetch(&self.tris[t as usize]);
+        }
+    }
+
+    /// Position of vertex `v` in `f64` (input positions widen exactly).
+    #[inline]
+    fn p(&self, v: u32) -> DVec3 {
+        match self.pos.get(v as usize) {
+            Some(p) => p.as_dvec3(),
+            None => self.appended_pos[v as usize - self.pos.len()],
+        }
+    }
+
+    /// Unit normal of input triangle `t` (zero for a zero-area one),
+    /// normalised in `f64` as when it was stored that way.
+    #[inline]
+    fn input_normal(&self, t: u32) -> DVec3 {
+        self.normals0[t as usize].as_dvec3().normalize_or_zero()
+    }
+
     /// Calls `f` once for every current neighbour or virtual partner of `v`.
     fn for_each_partner(&mut self, v: u32, mut f: impl FnMut(&mut Contractor, u32)) {
         let epoch = self.next_epoch();
         let list = std::mem::take(&mut self.vertex_tris[v as usize]);
         for &t in &list {
-            if !self.alive[t as usize] {
+            if self.tris[t as usize][0] == DEAD {
                 continue;
             }
             for w in self.tris[t as usize] {
@@ -300,6 +314,9 @@ impl Contractor {
     /// The cheapest target of `v` among its neighbours and virtual
     /// partners that no guard refused yet: `(cost, target)`.
     fn best(&mut self, v: u32) -> Option<(f64, u32)> {
+        if self.placement == Placement::Endpoint {
+            return self.best_endpoint(v);
+        }
         let mut best: Option<(f64, u32)> = None;
         let blocked = std::mem::take(&mut self.blocked[v as usize]);
         self.for_each_partner(v, |c, w| {
@@ -315,12 +332,49 @@ impl Contractor {
         best
     }
 
+    /// [`Contractor::best`] in endpoint mode, the hot path: `v`'s quadric is
+    /// loaded once, and neighbours are not deduplicated (each is seen once
+    /// per shared triangle; the choice does not depend on repeats).
+    fn best_endpoint(&self, v: u32) -> Option<(f64, u32)> {
+        let q = &self.quadrics[v as usize];
+        let blocked = &self.blocked[v as usize];
+        let mut best: Option<(f64, u32)> = None;
+        let mut consider = |w: u32| {
+            if blocked.contains(&w) {
+                return;
+            }
+            let cost = q.mean_error(self.p(w));
+            if best.is_none_or(|(bc, bw)| cost < bc || (cost == bc && w < bw)) {
+                best = Some((cost, w));
+            }
+        };
+        for &t in &self.vertex_tris[v as usize] {
+            let tri = self.tris[t as usize];
+            if tri[0] == DEAD {
+                continue;
+            }
+            for w in tri {
+                if w != v {
+                    consider(w);
+                }
+            }
+        }
+        if let Some(partners) = self.partners.get(v as usize) {
+            for &w in partners {
+                if !self.removed[w as usize] {
+                    consider(w);
+                }
+            }
+        }
+        best
+    }
+
     /// Recomputes `v`'s cheapest contraction and queues it when it changed
     /// (the old entry then goes stale).
     fn refresh(&mut self, v: u32) {
         // Drop the triangles that died around `v` while it stayed.
         let mut list = std::mem::take(&mut self.vertex_tris[v as usize]);
-        list.retain(|&t| self.alive[t as usize]);
+        list.retain(|&t| self.tris[t as usize][0] != DEAD);
         self.vertex_tris[v as usize] = list;
         let new = self
             .best(v)
@@ -331,19 +385,18 @@ impl Contractor {
         }
     }
 
-    /// Makes `v → target` at `cost` the vertex's one current entry (no
-    /// entry for [`NONE`]); older entries of `v` go stale.
+    /// Makes `v → target` at `cost` the vertex's one current entry (none
+    /// for [`NONE`]). A key is pushed only when `cost` is below every key
+    /// `v` has in the queue; otherwise the lowest one pops first and is
+    /// pushed again at the then queued cost (see [`Contractor::heap`]).
+    /// Keys are not told apart by target: equal keys pop together and the
+    /// first stands for the current choice.
     fn queue(&mut self, v: u32, cost: f32, target: u32) {
         self.queued[v as usize] = (cost, target);
-        let version = &mut self.version[v as usize];
-        *version = version.wrapping_add(1);
-        if target != NONE {
-            self.heap.push(Entry {
-                cost,
-                vertex: v,
-                target,
-                stamp: *version,
-            });
+        let bits = cost_bits(cost);
+        if target != NONE && bits < self.floor[v as usize] {
+            self.floor[v as usize] = bits;
+            self.heap.push(key(cost, v));
         }
     }
 
@@ -383,12 +436,12 @@ impl Contractor {
     /// meshoptimizer's Hausdorff on `ogre` at 10%), and the mean (not the
     /// area-weighted sum) keeps large flat regions from looking expensive.
     fn cost(&self, removed: u32, kept: u32) -> f64 {
-        self.quadrics[removed as usize].mean_error(self.pos[kept as usize])
+        self.quadrics[removed as usize].mean_error(self.p(kept))
     }
 
     /// The quadric's minimiser, or the best of the endpoints and midpoint.
     fn optimal_point(&self, q: &Quadric, a: u32, b: u32) -> (DVec3, f64) {
-        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let (pa, pb) = (self.p(a), self.p(b));
         let mut best = (pb, q.mean_error(pb));
         for p in [pa, 0.5 * (pa + pb)].into_iter().chain(q.minimizer()) {
             let cost = q.mean_error(p);
@@ -408,7 +461,7 @@ impl Contractor {
                     Some(self.stop_record(StopReason::TargetReached, RoundStats::default()));
                 return;
             }
-            let Some(e) = self.heap.pop() else {
+            let Some(k) = self.heap.pop() else {
                 // A round ends. Refused pairs may have become valid since
                 // (a guard looks at more than the two vertices' own
                 // neighbourhoods); try everything again unless the round
@@ -422,8 +475,20 @@ impl Contractor {
                 round = RoundStats::default();
                 continue;
             };
-            let (a, b) = (e.vertex, e.target);
-            if self.removed[a as usize] || self.version[a as usize] != e.stamp {
+            let a = k as u32;
+            // Other keys of `a` may remain, but none lower.
+            self.floor[a as usize] = NO_KEY;
+            let (cost, b) = self.queued[a as usize];
+            if self.removed[a as usize] || b == NONE {
+                continue;
+            }
+            let (popped, bits) = ((k >> 32) as u32, cost_bits(cost));
+            if popped != bits {
+                if popped < bits {
+                    // The cost rose since this key: queue it where it is now.
+                    self.floor[a as usize] = bits;
+                    self.heap.push(key(cost, a));
+                }
                 continue;
             }
             if self.removed[b as usize] {
@@ -434,7 +499,7 @@ impl Contractor {
             }
             let target = self.target_position(a, b);
             match self.check(a, b, target) {
-                Ok(()) => self.contract(a, b, target, e.cost),
+                Ok(()) => self.contract(a, b, target, cost),
                 Err(why) => {
                     round.candidates += 1;
                     match why {
@@ -451,10 +516,11 @@ impl Contractor {
 
     /// Forgets every refusal and queues every live vertex again.
     fn requeue_all(&mut self) {
-        for v in 0..self.pos.len() as u32 {
+        for v in 0..self.removed.len() as u32 {
             self.forget_refusals(v);
             if !self.removed[v as usize] {
                 self.queued[v as usize] = (f32::NAN, NONE);
+                self.floor[v as usize] = NO_KEY;
                 self.refresh(v);
             }
         }
@@ -463,7 +529,7 @@ impl Contractor {
     /// Where the surviving vertex of `a → b` goes.
     fn target_position(&self, a: u32, b: u32) -> DVec3 {
         match self.placement {
-            Placement::Endpoint => self.pos[b as usize],
+            Placement::Endpoint => self.p(b),
             Placement::Optimal => {
                 let q = self.quadrics[a as usize] + self.quadrics[b as usize];
                 self.optimal_point(&q, a, b).0
@@ -474,6 +540,8 @@ impl Contractor {
     /// The guards of the module docs for contracting `a` into `b` placed at
     /// `target`. Allocation-free; O(valence(a) · valence(b)) at worst.
     fn check(&mut self, a: u32, b: u32, target: DVec3) -> Result<(), Reject> {
+        self.prefetch_ring(a);
+        self.prefetch_ring(b);
         // Topology rule, after meshoptimizer's vertex kinds: an interior
         // vertex goes anywhere; a vertex on a border (an edge with other
         // than two triangles) leaves only along such an edge, so the border
@@ -495,7 +563,7 @@ impl Contractor {
         let apex = epoch + 1;
         // Mark a's neighbours.
         for &t in &self.vertex_tris[a as usize] {
-            if self.alive[t as usize] {
+            if self.tris[t as usize][0] != DEAD {
                 for w in self.tris[t as usize] {
                     self.mark[w as usize] = epoch;
                 }
@@ -505,7 +573,7 @@ impl Contractor {
         // neighbours.
         for &t in &self.vertex_tris[b as usize] {
             let tri = self.tris[t as usize];
-            if self.alive[t as usize] && tri.contains(&a) {
+            if self.tris[t as usize][0] != DEAD && tri.contains(&a) {
                 for w in tri {
                     if w != a && w != b {
                         self.mark[w as usize] = apex;
@@ -515,7 +583,7 @@ impl Contractor {
         }
         for &t in &self.vertex_tris[b as usize] {
             let tri = self.tris[t as usize];
-            if self.alive[t as usize]
+            if self.tris[t as usize][0] != DEAD
                 && !tri.contains(&a)
                 && tri
                     .iter()
@@ -528,7 +596,7 @@ impl Contractor {
         // no flipped normal.
         for &t in &self.vertex_tris[a as usize] {
             let tri = self.tris[t as usize];
-            if !self.alive[t as usize] || tri.contains(&b) {
+            if self.tris[t as usize][0] == DEAD || tri.contains(&b) {
                 continue;
             }
             let others = tri.map(|w| w != a && self.mark[w as usize] == apex);
@@ -542,7 +610,7 @@ impl Contractor {
         if self.placement == Placement::Optimal {
             for &t in &self.vertex_tris[b as usize] {
                 let tri = self.tris[t as usize];
-                if self.alive[t as usize] && !tri.contains(&a) && self.flips(t, b, target) {
+                if self.tris[t as usize][0] != DEAD && !tri.contains(&a) && self.flips(t, b, target) {
                     return Err(Reject::Flip);
                 }
             }
@@ -556,7 +624,7 @@ impl Contractor {
         let mut counts = std::mem::take(&mut self.scratch);
         counts.clear();
         for &t in &self.vertex_tris[v as usize] {
-            if !self.alive[t as usize] {
+            if self.tris[t as usize][0] == DEAD {
                 continue;
             }
             for x in self.tris[t as usize] {
@@ -580,7 +648,7 @@ impl Contractor {
     fn has_triangle_on(&self, b: u32, tri: [u32; 3], a: u32) -> bool {
         let want = tri.map(|w| if w == a { b } else { w });
         self.vertex_tris[b as usize].iter().any(|&u| {
-            self.alive[u as usize] && want.iter().all(|w| self.tris[u as usize].contains(w))
+            self.tris[u as usize][0] != DEAD && want.iter().all(|w| self.tris[u as usize].contains(w))
         })
     }
 
@@ -589,11 +657,11 @@ impl Contractor {
     /// without area.
     fn flips(&self, t: u32, v: u32, p: DVec3) -> bool {
         let tri = self.tris[t as usize];
-        let [p0, p1, p2] = tri.map(|w| self.pos[w as usize]);
+        let [p0, p1, p2] = tri.map(|w| self.p(w));
         let now = (p1 - p0).cross(p2 - p0);
-        let [q0, q1, q2] = tri.map(|w| if w == v { p } else { self.pos[w as usize] });
+        let [q0, q1, q2] = tri.map(|w| if w == v { p } else { self.p(w) });
         let next = (q1 - q0).cross(q2 - q0);
-        let input = self.normals0[t as usize];
+        let input = self.input_normal(t);
         // cos 75°: a pure 90° test lets a triangle fold over through a
         // series of near-90° turns (meshoptimizer makes the same choice).
         let limit = 0.25 * next.length();
@@ -617,14 +685,14 @@ impl Contractor {
         let survivor = match self.placement {
             Placement::Endpoint => b,
             Placement::Optimal => {
-                let c = self.pos.len() as u32;
-                self.pos.push(target);
+                let c = self.removed.len() as u32;
+                self.appended_pos.push(target);
                 self.quadrics.push(Quadric::default());
                 self.vertex_tris.push(Vec::new());
                 self.removed.push(false);
-                self.version.push(0);
                 self.mark.push(0);
                 self.queued.push((f32::NAN, NONE));
+                self.floor.push(NO_KEY);
                 self.blocked.push(Vec::new());
                 if !self.partners.is_empty() {
                     self.partners.push(Vec::new());
@@ -639,12 +707,12 @@ impl Contractor {
         let mut merged = std::mem::take(&mut self.vertex_tris[b as usize]);
         let mut dead = 0u32;
         merged.retain(|&t| {
-            if !self.alive[t as usize] {
+            if self.tris[t as usize][0] == DEAD {
                 return false;
             }
             let tri = &mut self.tris[t as usize];
             if tri.contains(&a) {
-                self.alive[t as usize] = false;
+                *tri = [DEAD; 3];
                 dead += 1;
                 return false;
             }
@@ -657,7 +725,7 @@ impl Contractor {
         });
         let from_a = std::mem::take(&mut self.vertex_tris[a as usize]);
         for &t in &from_a {
-            if !self.alive[t as usize] {
+            if self.tris[t as usize][0] == DEAD {
                 continue;
             }
             for w in self.tris[t as usize].iter_mut() {
@@ -691,8 +759,7 @@ impl Contractor {
         self.removed[a as usize] = true;
         // Entries of removed vertices are skipped by `removed`; the
         // survivor is refreshed below, which replaces its entry only when
-        // its choice changed (bumping its version here would drop it from
-        // the queue whenever the choice stayed the same).
+        // its choice changed (its key then stays current).
         for gone in [a, b] {
             if gone != survivor {
                 self.forget_refusals(gone);
@@ -722,6 +789,14 @@ impl Contractor {
             }
         });
         for &v in &ring {
+            prefetch(&self.queued[v as usize]);
+            prefetch(&self.vertex_tris[v as usize]);
+            prefetch(&self.quadrics[v as usize]);
+        }
+        for (i, &v) in ring.iter().enumerate() {
+            if let Some(&next) = ring.get(i + 1) {
+                self.prefetch_ring(next);
+            }
             if self.removed[v as usize] {
                 continue;
             }
@@ -746,8 +821,8 @@ impl Contractor {
     fn stop_record(&mut self, reason: StopReason, round: RoundStats) -> Stop {
         let epoch = self.next_epoch();
         let mut vertices = 0;
-        for (t, tri) in self.tris.iter().enumerate() {
-            if self.alive[t] {
+        for tri in &self.tris {
+            if tri[0] != DEAD {
                 for &w in tri {
                     if self.mark[w as usize] != epoch {
                         self.mark[w as usize] = epoch;
@@ -779,10 +854,122 @@ impl Contractor {
     }
 }
 
+/// For each triangle, bit `slot` set when [`is_border`] holds for that
+/// edge slot. Works vertex by vertex on a local copy of the corners (the
+/// triangles around `a` read once, not once per slot).
+fn border_slots(tris: &[[u32; 3]], vertex_tris: &[Vec<u32>]) -> Vec<u8> {
+    const LOCAL: usize = 32;
+    let mut out = vec![0u8; tris.len()];
+    for (a, around) in vertex_tris.iter().enumerate() {
+        let a = a as u32;
+        if around.len() > LOCAL {
+            for &t in around {
+                let tri = tris[t as usize];
+                let k = tri.iter().position(|&w| w == a).unwrap_or(0);
+                if is_border(tris, around, t, a, tri[(k + 1) % 3]) {
+                    out[t as usize] |= 1 << k;
+                }
+            }
+            continue;
+        }
+        // Corners around `a`: the vertex after and before it, and its slot.
+        let (mut next, mut prev, mut slot) = ([0u32; LOCAL], [0u32; LOCAL], [0u8; LOCAL]);
+        for (i, &t) in around.iter().enumerate() {
+            let tri = tris[t as usize];
+            let k = tri.iter().position(|&w| w == a).unwrap_or(0);
+            (next[i], prev[i], slot[i]) = (tri[(k + 1) % 3], tri[(k + 2) % 3], k as u8);
+        }
+        let k = around.len();
+        for i in 0..k {
+            let b = next[i];
+            // `around` is in increasing triangle order: earlier holders of
+            // (a, b) come first.
+            let rank = next[..i].iter().filter(|&&x| x == b).count();
+            let opposite = prev[..k].iter().filter(|&&x| x == b).count();
+            if rank >= opposite {
+                out[around[i] as usize] |= 1 << slot[i];
+            }
+        }
+    }
+    out
+}
+
+/// Whether the directed edge `(a, b)` of triangle `t` has no
+/// orientation-consistent neighbour as [`TriangleAdjacency`] pairs them (the
+/// `r`-th holder of `(a, b)` with the `r`-th holder of `(b, a)`, in triangle
+/// order), read from the triangles `around_a` of `a` (in increasing order)
+/// without building the whole adjacency.
+fn is_border(tris: &[[u32; 3]], around_a: &[u32], t: u32, a: u32, b: u32) -> bool {
+    let (mut rank, mut opposite) = (0u32, 0u32);
+    for &u in around_a {
+        let tri = tris[u as usize];
+        let k = tri.iter().position(|&w| w == a).unwrap_or(0);
+        if tri[(k + 1) % 3] == b && u < t {
+            rank += 1;
+        } else if tri[(k + 2) % 3] == b {
+            opposite += 1;
+        }
+    }
+    rank >= opposite
+}
+
+/// Hints the cache to load `x` (the loops here wait on memory, not on
+/// arithmetic, and their next loads are known early). No effect off x86-64.
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch of a valid reference never faults or writes.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(x).cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
 /// Rejections counted over one round of the queue.
 #[derive(Default, Clone, Copy)]
 struct RoundStats {
     candidates: usize,
     flip: usize,
     topology: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{TriangleAdjacency, NO_NEIGHBOUR};
+
+    /// `is_border` marks exactly the edge slots without a neighbour in
+    /// [`TriangleAdjacency`], fins and flipped triangles included.
+    #[test]
+    fn border_slots_match_the_adjacency() {
+        let grid: crate::mesh::generate::Generated = "grid:200".parse().unwrap();
+        let mut mesh = grid.build();
+        // A fin (three triangles on one edge), a flipped triangle and a
+        // lone one.
+        let [a, b] = [mesh.triangles[0][0], mesh.triangles[0][1]];
+        let extra = mesh.positions.len() as u32;
+        mesh.positions.push(glam::Vec3::new(0.3, 0.3, 1.0));
+        mesh.positions.push(glam::Vec3::new(0.5, 0.1, 2.0));
+        let [x, y, z] = mesh.triangles[5];
+        mesh.triangles.push([a, b, extra]);
+        mesh.triangles.push([b, a, extra + 1]);
+        mesh.triangles.push([y, x, extra + 1]);
+        mesh.triangles.push([x, z, extra]);
+        let adjacency = TriangleAdjacency::new(&mesh);
+        let around = vertex_triangles(mesh.positions.len(), &mesh.triangles);
+        let slots = border_slots(&mesh.triangles, &around);
+        let mut borders = 0;
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for slot in 0..3 {
+                let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
+                let border = is_border(&mesh.triangles, &around[a as usize], t as u32, a, b);
+                assert_eq!(border, adjacency.neighbours[t][slot] == NO_NEIGHBOUR);
+                assert_eq!(border, slots[t] & (1 << slot) != 0);
+                borders += usize::from(border);
+            }
+        }
+        assert!(borders > 10);
+    }
 }

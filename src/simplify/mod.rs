@@ -9,6 +9,7 @@
 mod collapses;
 mod contract;
 mod pairs;
+mod queue;
 pub mod quadric;
 
 pub use collapses::{Collapse, Collapses};
