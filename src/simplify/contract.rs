@@ -610,7 +610,8 @@ impl Contractor {
         if self.placement == Placement::Optimal {
             for &t in &self.vertex_tris[b as usize] {
                 let tri = self.tris[t as usize];
-                if self.tris[t as usize][0] != DEAD && !tri.contains(&a) && self.flips(t, b, target) {
+                if self.tris[t as usize][0] != DEAD && !tri.contains(&a) && self.flips(t, b, target)
+                {
                     return Err(Reject::Flip);
                 }
             }
@@ -648,7 +649,8 @@ impl Contractor {
     fn has_triangle_on(&self, b: u32, tri: [u32; 3], a: u32) -> bool {
         let want = tri.map(|w| if w == a { b } else { w });
         self.vertex_tris[b as usize].iter().any(|&u| {
-            self.tris[u as usize][0] != DEAD && want.iter().all(|w| self.tris[u as usize].contains(w))
+            self.tris[u as usize][0] != DEAD
+                && want.iter().all(|w| self.tris[u as usize].contains(w))
         })
     }
 

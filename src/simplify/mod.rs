@@ -9,8 +9,8 @@
 mod collapses;
 mod contract;
 mod pairs;
-mod queue;
 pub mod quadric;
+mod queue;
 
 pub use collapses::{Collapse, Collapses};
 pub use contract::simplify;

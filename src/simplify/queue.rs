@@ -70,9 +70,10 @@ impl Queue {
                 break;
             }
             let (mut m, mut mk) = (first, keys[first]);
-            for c in first + 1..(first + 4).min(n) {
-                if keys[c] < mk {
-                    (m, mk) = (c, keys[c]);
+            let end = (first + 4).min(n);
+            for (j, &k) in keys[first + 1..end].iter().enumerate() {
+                if k < mk {
+                    (m, mk) = (first + 1 + j, k);
                 }
             }
             if mk >= last {
