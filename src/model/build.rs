@@ -151,7 +151,6 @@ pub fn build_with_progress(
     positions.extend_from_slice(collapses.appended());
     let mut model = MtsModel {
         positions,
-        triangle_counts: counts.to_vec(),
         strip_nodes: vec![0],
         strip_begins: vec![0],
         band_strips: vec![0],

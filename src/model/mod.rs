@@ -55,12 +55,11 @@ pub const NODE_MASK: u32 = RESTART - 1;
 /// vertex count; every arc target is [`END`] or a later node of the same
 /// strip (optionally with [`RESTART`]); labels are at most `max_lod` and
 /// strictly increasing along a node's arcs and along a strip's beginnings,
-/// and a strip's last beginning has label `max_lod`; the triangle table has
-/// `max_lod + 1` non-increasing entries.
+/// and a strip's last beginning has label `max_lod`. The LoD → triangle
+/// table is the contraction sequence's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MtsModel {
     pub(crate) positions: Vec<Vec3>,
-    pub(crate) triangle_counts: Vec<u32>,
     pub(crate) strip_nodes: Vec<u32>,
     pub(crate) strip_begins: Vec<u32>,
     /// Per beginning: the first node (global index) or [`END`] for "the
@@ -115,7 +114,7 @@ impl MtsModel {
     /// Number of contractions; LoDs run from 0 to `max_lod()`.
     #[must_use]
     pub fn max_lod(&self) -> usize {
-        self.triangle_counts.len().saturating_sub(1)
+        self.recipe.collapses.max_lod()
     }
 
     /// The vertices the strips index (input vertices, then those created
@@ -128,31 +127,29 @@ impl MtsModel {
     /// Triangles drawn at `lod` (clamped to `max_lod()`).
     #[must_use]
     pub fn triangle_count(&self, lod: usize) -> usize {
-        self.triangle_counts[lod.min(self.max_lod())] as usize
+        self.recipe
+            .collapses
+            .triangle_count(lod.min(self.max_lod()))
     }
 
     /// The monotone LoD → triangle count table.
     #[must_use]
     pub fn triangle_counts(&self) -> &[u32] {
-        &self.triangle_counts
+        self.recipe.collapses.triangle_counts()
     }
 
-    /// The finest LoD with at most `budget` triangles (`max_lod()` when even
-    /// the coarsest has more). O(log LoDs).
+    /// The finest LoD with at most `budget` triangles (see
+    /// [`crate::Collapses::lod_for_triangles`]).
     #[must_use]
     pub fn lod_for_triangles(&self, budget: usize) -> usize {
-        let k = self
-            .triangle_counts
-            .partition_point(|&t| t as usize > budget);
-        k.min(self.max_lod())
+        self.recipe.collapses.lod_for_triangles(budget)
     }
 
-    /// [`MtsModel::lod_for_triangles`] for `ratio` of the full triangle count
-    /// (clamped to 0..=1, rounded to the nearest count).
+    /// The LoD for `ratio` of the full triangle count (see
+    /// [`crate::Collapses::lod_for_ratio`]).
     #[must_use]
     pub fn lod_for_ratio(&self, ratio: f64) -> usize {
-        let full = f64::from(self.triangle_counts.first().copied().unwrap_or(0));
-        self.lod_for_triangles((ratio.clamp(0.0, 1.0) * full).round() as usize)
+        self.recipe.collapses.lod_for_ratio(ratio)
     }
 
     /// The contraction sequence the model was built from.
@@ -212,8 +209,7 @@ impl MtsModel {
     /// Node, arc and byte counts.
     #[must_use]
     pub fn stats(&self) -> ModelStats {
-        let words = self.triangle_counts.len()
-            + self.strip_nodes.len()
+        let words = self.strip_nodes.len()
             + self.strip_begins.len()
             + self.begin_node.len()
             + self.begin_res.len()
@@ -257,12 +253,6 @@ impl MtsModel {
     /// A description of the first broken invariant.
     pub fn check(&self) -> Result<(), String> {
         let max_lod = self.max_lod() as u32;
-        if self.triangle_counts.is_empty() {
-            return Err("empty triangle table".into());
-        }
-        if let Some(k) = self.triangle_counts.windows(2).position(|w| w[1] > w[0]) {
-            return Err(format!("triangle table increases at LoD {}", k + 1));
-        }
         check_offsets("strip node", &self.strip_nodes, self.node_vertex.len())?;
         check_offsets("strip beginning", &self.strip_begins, self.begin_node.len())?;
         check_offsets("node arc", &self.node_arcs, self.arc_target.len())?;
