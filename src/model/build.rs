@@ -173,6 +173,12 @@ pub fn build_with_progress(
         positions: mesh.positions.clone(),
         triangles: strips.triangles(),
     };
+    // The mesh each later band is stripified from: every vertex (appended
+    // ones too), its triangles replaced band by band.
+    let mut band_mesh = Mesh {
+        positions: model.positions.clone(),
+        triangles: Vec::new(),
+    };
     let slack = options.band_slack.max(MIN_BAND_SLACK);
     let vertex_total = model.positions.len();
     let optimal = collapses.is_optimal_placement();
@@ -183,11 +189,8 @@ pub fn build_with_progress(
         let strips = if first == 0 {
             strips
         } else {
-            let at = Mesh {
-                positions: model.positions.clone(),
-                triangles: collapses.triangles_at(&base, first as usize),
-            };
-            band_strips = stripify(&at, &options.stripify);
+            band_mesh.triangles = collapses.triangles_at(&base, first as usize);
+            band_strips = stripify(&band_mesh, &options.stripify);
             &band_strips
         };
         let mut builder = Builder::new(strips, vertex_total, first);
@@ -391,42 +394,14 @@ impl Builder {
         self.occ_next[gp as usize] = NONE;
     }
 
-    /// Last live window at or before `w` (in `w`'s strip), with path halving.
-    fn find_prev(&mut self, mut w: u32) -> Option<u32> {
-        loop {
-            let l = self.prev_link[w as usize];
-            if l == w {
-                return Some(w);
-            }
-            if l == NONE {
-                return None;
-            }
-            let ll = self.prev_link[l as usize];
-            self.prev_link[w as usize] = ll;
-            if ll == NONE {
-                return None;
-            }
-            w = ll;
-        }
+    /// Last live window at or before `w` (in `w`'s strip).
+    fn find_prev(&mut self, w: u32) -> Option<u32> {
+        find_live(&mut self.prev_link, w)
     }
 
     /// First live window at or after `w` (in `w`'s strip).
-    fn find_next(&mut self, mut w: u32) -> Option<u32> {
-        loop {
-            let l = self.next_link[w as usize];
-            if l == w {
-                return Some(w);
-            }
-            if l == NONE {
-                return None;
-            }
-            let ll = self.next_link[l as usize];
-            self.next_link[w as usize] = ll;
-            if ll == NONE {
-                return None;
-            }
-            w = ll;
-        }
+    fn find_next(&mut self, w: u32) -> Option<u32> {
+        find_live(&mut self.next_link, w)
     }
 
     fn strip_range(&self, s: usize) -> (u32, u32) {
@@ -797,6 +772,27 @@ impl Builder {
             }
             model.strip_begins.push(model.begin_node.len() as u32);
         }
+    }
+}
+
+/// Follows `links` from window `w` to the live window it leads to (a live
+/// window links to itself), halving the path on the way; `None` past the
+/// strip's end.
+fn find_live(links: &mut [u32], mut w: u32) -> Option<u32> {
+    loop {
+        let l = links[w as usize];
+        if l == w {
+            return Some(w);
+        }
+        if l == NONE {
+            return None;
+        }
+        let ll = links[l as usize];
+        links[w as usize] = ll;
+        if ll == NONE {
+            return None;
+        }
+        w = ll;
     }
 }
 
