@@ -39,6 +39,11 @@ enum Command {
     /// Describe an .mts file: sizes, bands, and strip quality at several
     /// LoDs against stripifying that LoD's mesh from scratch.
     Info(InfoArgs),
+    /// Extract one LoD of a model as restart-encoded strips.
+    Extract(ExtractArgs),
+    /// Check a model against the replay oracle and coherent against
+    /// from-scratch extraction; exits non-zero on any mismatch.
+    Verify(VerifyArgs),
 }
 
 #[derive(Args)]
@@ -62,6 +67,31 @@ struct BuildArgs {
     /// Optimal placement in the contraction sequence (new vertices).
     #[arg(long)]
     optimal: bool,
+}
+
+impl BuildArgs {
+    fn pipeline_options(&self) -> mts::model::PipelineOptions {
+        use mts::simplify::{Placement, SimplifyOptions};
+        mts::model::PipelineOptions {
+            simplify: SimplifyOptions {
+                placement: if self.optimal {
+                    Placement::Optimal
+                } else {
+                    Placement::Endpoint
+                },
+                ..SimplifyOptions::default()
+            },
+            build: mts::model::BuildOptions {
+                band_slack: if self.single_band {
+                    f64::INFINITY
+                } else {
+                    self.band_slack
+                },
+                ..mts::model::BuildOptions::default()
+            },
+            ..Default::default()
+        }
+    }
 }
 
 #[derive(Args)]
@@ -461,6 +491,14 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Convert(args) => convert(args),
         Command::Build(args) => build(args),
         Command::Info(args) => info(args),
+        Command::Extract(args) => extract(args),
+        Command::Verify(args) => {
+            if verify(args)? {
+                Ok(())
+            } else {
+                bail!("the model breaks the invariant (see above)")
+            }
+        }
     }
 }
 
@@ -468,59 +506,9 @@ fn run(cli: &Cli) -> Result<()> {
 const PROGRESS_MIN_TRIANGLES: usize = 200_000;
 
 fn build(args: &BuildArgs) -> Result<()> {
-    use indicatif::{ProgressBar, ProgressStyle};
-    use mts::model::{build_with_progress, BuildOptions};
-    use mts::simplify::{Placement, SimplifyOptions};
     let (name, mesh, _) = args.source.load()?;
-    let bar = if mesh.triangle_count() >= PROGRESS_MIN_TRIANGLES {
-        ProgressBar::new(4)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} {msg:12} [{bar:30}] {pos}/{len} {elapsed}")
-            .expect("valid template"),
-    );
-    bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    let t0 = Instant::now();
-    bar.set_message("stripify");
-    let strips = stripify(&mesh, &StripifyOptions::default());
-    let t_strips = t0.elapsed();
-    bar.set_message("simplify");
-    let options = SimplifyOptions {
-        placement: if args.optimal {
-            Placement::Optimal
-        } else {
-            Placement::Endpoint
-        },
-        ..SimplifyOptions::default()
-    };
-    let simplification = mts::simplify(&mesh, &options);
-    let t_simplify = t0.elapsed() - t_strips;
-    let collapses = simplification.collapses;
-    bar.set_message("model");
-    bar.set_length(collapses.max_lod().max(1) as u64);
-    let build_options = BuildOptions {
-        band_slack: if args.single_band {
-            f64::INFINITY
-        } else {
-            args.band_slack
-        },
-        ..BuildOptions::default()
-    };
-    let t1 = Instant::now();
-    let model = build_with_progress(
-        &mesh,
-        &strips,
-        &collapses,
-        &build_options,
-        &mut |done, _| {
-            bar.set_position(done as u64);
-        },
-    );
-    let t_model = t1.elapsed();
-    let total = t0.elapsed();
-    bar.finish_and_clear();
+    let options = args.pipeline_options();
+    let (model, _, t) = build_with_bar(&mesh, &options);
     let bytes = model.to_bytes();
     std::fs::write(&args.output, &bytes)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
@@ -531,20 +519,20 @@ fn build(args: &BuildArgs) -> Result<()> {
             "{}",
             json!({
                 "input": name,
-                "input_triangles": mesh.triangle_count(),
                 "vertices": mesh.vertex_count(),
+                "triangles": mesh.triangle_count(),
                 "max_lod": model.max_lod(),
                 "strips": st.strips,
+                "bytes": bytes.len(),
+                "raw_bytes": model.raw_bytes(),
                 "bands": model.band_count(),
                 "nodes": st.nodes,
                 "arcs": st.arcs,
                 "memory_bytes": st.memory_bytes,
-                "file_bytes": bytes.len(),
-                "raw_bytes": model.raw_bytes(),
-                "ms_stripify": ms(t_strips),
-                "ms_simplify": ms(t_simplify),
-                "ms_model": ms(t_model),
-                "ms": ms(total),
+                "ms_stripify": ms(t.stripify),
+                "ms_simplify": ms(t.simplify),
+                "ms_model": ms(t.model),
+                "ms": ms(t.total),
             })
         );
     } else {
@@ -555,11 +543,11 @@ fn build(args: &BuildArgs) -> Result<()> {
             model.max_lod() + 1
         );
         println!(
-            "  time      stripify {:.1} ms, simplify {:.1} ms, model {:.1} ms, total {:.1} ms",
-            ms(t_strips),
-            ms(t_simplify),
-            ms(t_model),
-            ms(total)
+            "  time      stripify {:.1} ms beside simplify {:.1} ms, model {:.1} ms, total {:.1} ms",
+            ms(t.stripify),
+            ms(t.simplify),
+            ms(t.model),
+            ms(t.total)
         );
         println!(
             "  model     {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
@@ -570,7 +558,7 @@ fn build(args: &BuildArgs) -> Result<()> {
             st.memory_bytes as f64 / 1e6
         );
         println!(
-            "  file      {} bytes = {:.2} x raw ({} bytes: 12 per vertex + 6 per triangle) -> {}",
+            "  file      {} bytes = {:.2} x raw ({} bytes: 12 per vertex + 12 per triangle) -> {}",
             bytes.len(),
             bytes.len() as f64 / model.raw_bytes() as f64,
             model.raw_bytes(),
@@ -578,6 +566,219 @@ fn build(args: &BuildArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The whole pipeline with a progress bar on large inputs.
+fn build_with_bar(
+    mesh: &Mesh,
+    options: &mts::model::PipelineOptions,
+) -> (
+    mts::MtsModel,
+    mts::simplify::Stop,
+    mts::model::PipelineTimings,
+) {
+    use indicatif::{ProgressBar, ProgressStyle};
+    let bar = if mesh.triangle_count() >= PROGRESS_MIN_TRIANGLES {
+        ProgressBar::new(1)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg:16} [{bar:30}] {pos}/{len} {elapsed}")
+            .expect("valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar.set_message("strips + QEM");
+    let mut started = false;
+    let out = mts::model::build_from_mesh(mesh, options, &mut |done, max_lod| {
+        if !started {
+            bar.set_message("graphs (LoDs)");
+            bar.set_length(max_lod.max(1) as u64);
+            started = true;
+        }
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    out
+}
+
+/// A model to read: an `.mts` file, or a mesh whose model is built first.
+#[derive(Args)]
+struct ModelSource {
+    /// An .mts file, or an OBJ/PLY mesh (its model is built first with the
+    /// default options).
+    #[arg(conflicts_with = "generated")]
+    input: Option<PathBuf>,
+    /// Built-in mesh NAME:SIZE (see `mts strips --help`); the default when
+    /// no input is given.
+    #[arg(long, value_name = "NAME:SIZE")]
+    generated: Option<Generated>,
+}
+
+impl ModelSource {
+    /// The model and its full-resolution mesh.
+    fn load(&self) -> Result<(String, mts::MtsModel)> {
+        if let Some(path) = &self.input {
+            let is_mts = std::fs::File::open(path)
+                .and_then(|mut f| {
+                    use std::io::Read;
+                    let mut magic = [0u8; 8];
+                    f.read_exact(&mut magic)
+                        .map(|()| &magic == mts::model::format::MAGIC)
+                })
+                .unwrap_or(false);
+            if is_mts {
+                let model = mts::MtsModel::load(path)?;
+                return Ok((path.display().to_string(), model));
+            }
+        }
+        let source = MeshSource {
+            mesh: self.input.clone(),
+            generated: self.generated,
+            weld: false,
+        };
+        let (name, mesh, _) = source.load()?;
+        let (model, _, _) = build_with_bar(&mesh, &Default::default());
+        Ok((name, model))
+    }
+}
+
+#[derive(Args)]
+#[command(group(clap::ArgGroup::new("level").required(true).args(["lod", "triangles", "ratio"])))]
+struct ExtractArgs {
+    #[command(flatten)]
+    source: ModelSource,
+    /// The LoD (0 is the full mesh; clamped to the last).
+    #[arg(long)]
+    lod: Option<usize>,
+    /// The finest LoD with at most this many triangles.
+    #[arg(long)]
+    triangles: Option<usize>,
+    /// The LoD with this share of the full triangle count (0..1).
+    #[arg(long)]
+    ratio: Option<f64>,
+    /// Write the extracted triangles as OBJ.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Timed extractions from scratch; the median is reported.
+    #[arg(long, default_value_t = 11)]
+    repeat: usize,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+fn extract(args: &ExtractArgs) -> Result<()> {
+    use mts::Extractor;
+    let (name, model) = args.source.load()?;
+    let lod = match (args.lod, args.triangles, args.ratio) {
+        (Some(l), _, _) => l.min(model.max_lod()),
+        (_, Some(n), _) => model.lod_for_triangles(n),
+        (_, _, Some(r)) => {
+            if !(0.0..=1.0).contains(&r) {
+                bail!("--ratio must be between 0 and 1, not {r}");
+            }
+            model.lod_for_ratio(r)
+        }
+        _ => bail!("give --lod, --triangles or --ratio"),
+    };
+    // Each timed extraction starts from an empty extractor (no coherence).
+    let mut times = Vec::with_capacity(args.repeat.max(1));
+    let mut ex = Extractor::new(&model);
+    for _ in 0..args.repeat.max(1) {
+        ex = Extractor::new(&model);
+        let t = Instant::now();
+        ex.set_lod(lod);
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    times.sort_by(f64::total_cmp);
+    let us = times[times.len() / 2];
+    let mut compact = Vec::new();
+    ex.write_compact(&mut compact);
+    let runs = compact
+        .split(|&i| i == mts::strip::encode::RESTART_U32)
+        .filter(|r| !r.is_empty())
+        .count();
+    let triangles = model.triangle_count(lod);
+    if let Some(out) = &args.output {
+        let mesh = Mesh {
+            positions: model.positions().to_vec(),
+            triangles: ex.triangles(),
+        };
+        mts::mesh::io::save_obj(&mesh, out)?;
+    }
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "lod": lod,
+                "max_lod": model.max_lod(),
+                "triangles": triangles,
+                "strips": runs,
+                "indices": ex.indices_sent(),
+                "indices_per_triangle": ex.indices_sent() as f64 / triangles.max(1) as f64,
+                "us": us,
+            })
+        );
+    } else {
+        println!(
+            "{name}: LoD {lod} of {}: {triangles} triangles in {runs} strips, {} indices sent ({:.3} per triangle), extracted in {us:.1} us (median of {} from scratch)",
+            model.max_lod(),
+            ex.indices_sent(),
+            ex.indices_sent() as f64 / triangles.max(1) as f64,
+            times.len()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+struct VerifyArgs {
+    #[command(flatten)]
+    source: ModelSource,
+    /// `all`, or a number of LoDs spread evenly from 0 to the last.
+    #[arg(long, default_value = "all")]
+    lods: String,
+    /// Print JSON instead of a sentence.
+    #[arg(long)]
+    json: bool,
+}
+
+fn verify(args: &VerifyArgs) -> Result<bool> {
+    let (name, model) = args.source.load()?;
+    let n = match args.lods.as_str() {
+        "all" => None,
+        text => Some(
+            text.parse::<usize>()
+                .with_context(|| format!("--lods takes `all` or a number, not `{text}`"))?,
+        ),
+    };
+    let lods = mts::model::spread_lods(model.max_lod(), n);
+    let t = Instant::now();
+    let report = mts::model::verify(&model, &model.mesh(), &lods);
+    let secs = t.elapsed().as_secs_f64();
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "lods_checked": report.lods_checked,
+                "mismatches": report.mismatches,
+                "first_mismatch": report.first_mismatch.as_ref().map(|(l, what)| json!({"lod": l, "what": what})),
+                "seconds": secs,
+            })
+        );
+    } else {
+        println!(
+            "{name}: {} LoDs checked against the replay oracle and from-scratch extraction in {secs:.2} s, {} mismatches",
+            report.lods_checked, report.mismatches
+        );
+        if let Some((lod, what)) = &report.first_mismatch {
+            println!("  first at LoD {lod}: {what}");
+        }
+    }
+    Ok(report.mismatches == 0)
 }
 
 fn info(args: &InfoArgs) -> Result<()> {

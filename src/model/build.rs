@@ -106,6 +106,10 @@ pub const MIN_BAND_SLACK: f64 = 0.01;
 /// make the loader stripify once per LoD.
 pub const MIN_BAND_DROP: f64 = 0.02;
 
+/// Share of the triangles a construction segment spans (see
+/// `Context::segment_starts`): halving segments keep two threads busy.
+pub const SEGMENT_DROP: f64 = 0.5;
+
 /// Builds the MTS model of `mesh` from its strips (those of LoD 0) and its
 /// contraction sequence; later bands are stripified from the mesh at their
 /// first LoD with `options.stripify`.
@@ -146,18 +150,71 @@ pub fn build_with_progress(
         "collapses of another mesh"
     );
     let max_lod = collapses.max_lod() as u32;
-    let counts = collapses.triangle_counts();
     let mut positions = mesh.positions.clone();
     positions.extend_from_slice(collapses.appended());
-    let mut model = MtsModel {
+    let ctx = Context {
+        // Bands are stripified from the strips' own triangles, so that a
+        // model built again from its file (which stores the strips) is the
+        // same.
+        base: Mesh {
+            positions: mesh.positions.clone(),
+            triangles: strips.triangles(),
+        },
         positions,
+        collapses,
+        options,
+        slack: options.band_slack.max(MIN_BAND_SLACK),
+        max_lod,
+    };
+    let starts = ctx.segment_starts();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let slots: Vec<std::sync::Mutex<Option<Part>>> =
+        starts.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    // Segments are taken in order, largest first, by every thread.
+    let work = || -> Option<usize> {
+        use std::sync::atomic::Ordering::Relaxed;
+        let i = next.fetch_add(1, Relaxed);
+        let &first = starts.get(i)?;
+        let last = starts.get(i + 1).map_or(max_lod, |&n| n - 1);
+        let part = ctx.segment(first, last, strips);
+        *slots[i]
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(part);
+        let lods = (last - first + 1) as usize;
+        Some(done.fetch_add(lods, Relaxed) + lods)
+    };
+    let threads = std::thread::available_parallelism()
+        .map_or(1, std::num::NonZeroUsize::get)
+        .min(starts.len());
+    std::thread::scope(|scope| {
+        let helpers: Vec<_> = (1..threads)
+            .map(|_| scope.spawn(|| while work().is_some() {}))
+            .collect();
+        while let Some(d) = work() {
+            progress(d.saturating_sub(1), max_lod as usize);
+        }
+        for h in helpers {
+            if let Err(e) = h.join() {
+                std::panic::resume_unwind(e);
+            }
+        }
+    });
+    progress(max_lod as usize, max_lod as usize);
+    let parts = slots.into_iter().map(|m| {
+        m.into_inner()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .expect("every segment built")
+    });
+    let mut model = MtsModel {
+        positions: ctx.positions,
         strip_nodes: vec![0],
         strip_begins: vec![0],
         band_strips: vec![0],
         begin_node: Vec::new(),
         begin_res: Vec::new(),
         node_vertex: Vec::new(),
-        node_arcs: Vec::new(),
+        node_arcs: vec![0],
         arc_target: Vec::new(),
         arc_res: Vec::new(),
         band_lod: Vec::new(),
@@ -167,64 +224,186 @@ pub fn build_with_progress(
             options: options.clone(),
         },
     };
-    // Bands are stripified from the strips' own triangles, so that a model
-    // built again from its file (which stores the strips) is the same.
-    let base = Mesh {
-        positions: mesh.positions.clone(),
-        triangles: strips.triangles(),
-    };
-    // The mesh each later band is stripified from: every vertex (appended
-    // ones too), its triangles replaced band by band.
-    let mut band_mesh = Mesh {
-        positions: model.positions.clone(),
-        triangles: Vec::new(),
-    };
-    let slack = options.band_slack.max(MIN_BAND_SLACK);
-    let vertex_total = model.positions.len();
-    let optimal = collapses.is_optimal_placement();
-    let mut moved = Vec::with_capacity(2);
-    let mut first = 0u32;
-    loop {
-        let band_strips;
-        let strips = if first == 0 {
-            strips
-        } else {
-            band_mesh.triangles = collapses.triangles_at(&base, first as usize);
-            band_strips = stripify(&band_mesh, &options.stripify);
-            &band_strips
-        };
-        let mut builder = Builder::new(strips, vertex_total, first);
-        // Indices the band may send per triangle before the next band starts.
-        let start = counts[first as usize];
-        let limit = (1.0 + slack) * builder.indices() as f64 / f64::from(start.max(1));
-        let min_drop = (f64::from(start) * (1.0 - MIN_BAND_DROP)) as u32;
-        let mut last = max_lod;
-        for k in first + 1..=max_lod {
-            let i = k as usize - 1;
-            let step = &collapses.steps()[i];
-            moved.clear();
-            moved.push(step.removed);
-            if optimal {
-                moved.push(step.kept);
-            }
-            builder.contract(k, &moved, collapses.target(i));
-            let now = counts[k as usize];
-            if now <= min_drop && builder.indices() as f64 > limit * f64::from(now) {
-                last = k - 1;
-                break;
-            }
-        }
-        model.band_lod.push(first);
-        builder.finish_into(&mut model, first, last, max_lod);
-        model.band_strips.push(model.strip_nodes.len() as u32 - 1);
-        progress(last as usize, max_lod as usize);
-        if last == max_lod {
-            break;
-        }
-        first = last + 1;
+    for part in parts {
+        part.append_to(&mut model);
     }
     debug_assert_eq!(model.check(), Ok(()));
     model
+}
+
+/// What every band's construction reads.
+struct Context<'a> {
+    base: Mesh,
+    /// Every vertex, appended ones too.
+    positions: Vec<glam::Vec3>,
+    collapses: &'a Collapses,
+    options: &'a BuildOptions,
+    slack: f64,
+    max_lod: u32,
+}
+
+impl Context<'_> {
+    /// The first LoDs of the segments the sequence is cut into: each ends
+    /// where the triangle count has fallen by [`SEGMENT_DROP`].
+    ///
+    /// **Decision: bands are found within fixed segments, not one after
+    /// the other over the whole sequence.** Where a band ends depends on
+    /// how its strips degrade, so chaining bands makes the construction
+    /// sequential. A segment always starts a band and the slack rule still
+    /// ends bands inside it, so the quality bound holds, while segments are
+    /// independent and built in parallel. Halving segments balance two
+    /// threads (the first holds about half the work, the rest the other
+    /// half) and cost about one extra band per halving (bunny: 85 bands
+    /// instead of 69; ARCHITECTURE.md has the measurements). The cut does
+    /// not depend on the thread count, so the model does not either.
+    /// With an infinite slack (the paper's single band) there is one
+    /// segment.
+    fn segment_starts(&self) -> Vec<u32> {
+        let counts = self.collapses.triangle_counts();
+        let mut starts = Vec::new();
+        let mut a = 0;
+        while a <= self.max_lod {
+            if self.slack.is_infinite() && a > 0 {
+                break;
+            }
+            starts.push(a);
+            let target = (f64::from(counts[a as usize]) * (1.0 - SEGMENT_DROP)) as usize;
+            a = (self.collapses.lod_for_triangles(target) as u32).max(a + 1);
+        }
+        starts
+    }
+
+    /// Builds the bands of LoDs `first..=last`: a band starts at `first`
+    /// (from `strips`, or stripified from that LoD's mesh), and a new one
+    /// whenever the current one sends more than `1 + slack` times its
+    /// starting indices per triangle (and has lost at least
+    /// [`MIN_BAND_DROP`] of its triangles). At LoD 0 the band is
+    /// `base_strips`.
+    fn segment(&self, mut first: u32, last_lod: u32, base_strips: &Strips) -> Part {
+        let counts = self.collapses.triangle_counts();
+        let optimal = self.collapses.is_optimal_placement();
+        let mut part = Part::default();
+        let mut band_mesh = Mesh {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+        };
+        let mut moved = Vec::with_capacity(2);
+        loop {
+            let band_strips;
+            let strips = if first == 0 {
+                base_strips
+            } else {
+                if band_mesh.positions.is_empty() {
+                    band_mesh.positions.clone_from(&self.positions);
+                }
+                band_mesh.triangles = self.collapses.triangles_at(&self.base, first as usize);
+                band_strips = stripify(&band_mesh, &self.options.stripify);
+                &band_strips
+            };
+            let mut builder = Builder::new(strips, self.positions.len(), first);
+            // Indices the band may send per triangle before the next band
+            // starts.
+            let start = counts[first as usize];
+            let limit = (1.0 + self.slack) * builder.indices() as f64 / f64::from(start.max(1));
+            let min_drop = (f64::from(start) * (1.0 - MIN_BAND_DROP)) as u32;
+            let mut last = last_lod;
+            for k in first + 1..=last_lod {
+                let i = k as usize - 1;
+                let step = &self.collapses.steps()[i];
+                moved.clear();
+                moved.push(step.removed);
+                if optimal {
+                    moved.push(step.kept);
+                }
+                builder.contract(k, &moved, self.collapses.target(i));
+                let now = counts[k as usize];
+                if now <= min_drop && builder.indices() as f64 > limit * f64::from(now) {
+                    last = k - 1;
+                    break;
+                }
+            }
+            part.band_lod.push(first);
+            builder.finish_into(&mut part, first, last, self.max_lod);
+            part.band_strips.push(part.strip_nodes.len() as u32 - 1);
+            if last == last_lod {
+                return part;
+            }
+            first = last + 1;
+        }
+    }
+}
+
+/// The graphs of consecutive bands with nodes, arcs, beginnings and strips
+/// numbered from 0; [`Part::append_to`] renumbers them into the model.
+/// Same layout as the fields of [`MtsModel`].
+struct Part {
+    strip_nodes: Vec<u32>,
+    strip_begins: Vec<u32>,
+    begin_node: Vec<u32>,
+    begin_res: Vec<u32>,
+    node_vertex: Vec<u32>,
+    node_arcs: Vec<u32>,
+    arc_target: Vec<u32>,
+    arc_res: Vec<u32>,
+    band_lod: Vec<u32>,
+    band_strips: Vec<u32>,
+}
+
+impl Default for Part {
+    fn default() -> Part {
+        Part {
+            strip_nodes: vec![0],
+            strip_begins: vec![0],
+            begin_node: Vec::new(),
+            begin_res: Vec::new(),
+            node_vertex: Vec::new(),
+            node_arcs: vec![0],
+            arc_target: Vec::new(),
+            arc_res: Vec::new(),
+            band_lod: Vec::new(),
+            band_strips: vec![0],
+        }
+    }
+}
+
+impl Part {
+    /// Appends the part's arrays to `model`, shifting every offset and node
+    /// index by what the model already holds.
+    fn append_to(self, model: &mut MtsModel) {
+        let node_base = model.node_vertex.len() as u32;
+        let arc_base = model.arc_target.len() as u32;
+        let begin_base = model.begin_node.len() as u32;
+        let strip_base = model.strip_nodes.len() as u32 - 1;
+        let shift = |t: u32| {
+            if t == END {
+                END
+            } else {
+                ((t & NODE_MASK) + node_base) | (t & RESTART)
+            }
+        };
+        model
+            .strip_nodes
+            .extend(self.strip_nodes[1..].iter().map(|&o| o + node_base));
+        model
+            .strip_begins
+            .extend(self.strip_begins[1..].iter().map(|&o| o + begin_base));
+        model
+            .begin_node
+            .extend(self.begin_node.iter().map(|&t| shift(t)));
+        model.begin_res.extend_from_slice(&self.begin_res);
+        model.node_vertex.extend_from_slice(&self.node_vertex);
+        model
+            .node_arcs
+            .extend(self.node_arcs[1..].iter().map(|&o| o + arc_base));
+        model
+            .arc_target
+            .extend(self.arc_target.iter().map(|&t| shift(t)));
+        model.arc_res.extend_from_slice(&self.arc_res);
+        model.band_lod.extend_from_slice(&self.band_lod);
+        model
+            .band_strips
+            .extend(self.band_strips[1..].iter().map(|&o| o + strip_base));
+    }
 }
 
 /// A closed (or finally closed) arc: `node → target`, valid up to `res`.
@@ -692,7 +871,7 @@ impl Builder {
 
     /// Closes the band (its strips hold LoDs `first..=last`) and appends its
     /// strips to `model`, nodes numbered in strip order.
-    fn finish_into(mut self, model: &mut MtsModel, first: u32, last: u32, max_lod: u32) {
+    fn finish_into(mut self, model: &mut Part, first: u32, last: u32, max_lod: u32) {
         for n in 0..self.node_open.len() as u32 {
             self.close(n, last);
         }
@@ -741,6 +920,10 @@ impl Builder {
         }
         model.node_arcs.pop();
         model.node_arcs.extend(count.iter().map(|&c| arc_base + c));
+        debug_assert_eq!(
+            model.node_arcs.len(),
+            model.node_vertex.len() + node_count + 1
+        );
         model
             .node_vertex
             .extend(order.iter().map(|&n| self.node_vertex[n as usize]));

@@ -30,11 +30,15 @@
 mod build;
 mod extract;
 pub mod format;
+mod pipeline;
+mod verify;
 
 pub use build::{
     build, build_with_progress, BuildOptions, DEFAULT_BAND_SLACK, MIN_BAND_DROP, MIN_BAND_SLACK,
 };
 pub use extract::{Extractor, Update};
+pub use pipeline::{build_from_mesh, PipelineOptions, PipelineTimings};
+pub use verify::{spread_lods, verify, VerifyReport};
 
 use glam::Vec3;
 
@@ -228,12 +232,19 @@ impl MtsModel {
         }
     }
 
-    /// Bytes of a raw indexed mesh with the full-resolution triangle count:
-    /// 12 per vertex and 6 per triangle (16-bit indices), the reference of
-    /// the cluster-tree paper's Table 2.
+    /// Bytes of the raw input mesh with 32-bit indices: 12 per vertex
+    /// (three `f32`) and 12 per triangle (three `u32`). The reference of the
+    /// `.mts` size target and of `mts build --json`'s `raw_bytes`.
     #[must_use]
     pub fn raw_bytes(&self) -> usize {
-        12 * self.positions.len() + 6 * self.triangle_count(0)
+        12 * self.recipe.collapses.vertex_count() + 12 * self.triangle_count(0)
+    }
+
+    /// Bytes of the raw input mesh with 16-bit indices: 12 per vertex and 6
+    /// per triangle, the reference of the cluster-tree paper's Table 2.
+    #[must_use]
+    pub fn raw_bytes_u16(&self) -> usize {
+        12 * self.recipe.collapses.vertex_count() + 6 * self.triangle_count(0)
     }
 
     /// The nodes of strip `s`.

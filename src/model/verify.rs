@@ -1,0 +1,264 @@
+//! Checks a model against the invariant every test leans on
+//! (`../shared/DESIGN.md`, "The one invariant"): at each LoD the oriented
+//! triangles drawn from the extracted strips are exactly those of the naive
+//! replay of the contraction sequence, and coherent extraction is
+//! byte-identical to extraction from scratch.
+//!
+//! Checking every LoD of a 70K-triangle model naively would cost
+//! O(LoDs × triangles) for the oracle alone. Both sides are kept
+//! incrementally instead:
+//! - the oracle replays the contractions between two checked LoDs on a
+//!   triangle list with per-vertex incidence lists (a contraction visits
+//!   only the triangles around the vertices it moves);
+//! - the strips' triangles are updated from the coherent extractor's dirty
+//!   ranges (the runs they held before, kept in a shadow copy, go out; the
+//!   runs they hold now come in);
+//! - a map from oriented triangle (canonical rotation) to the difference
+//!   "drawn − oracle" counts how many entries are non-zero; the LoD passes
+//!   when none is.
+//!
+//! The from-scratch extractor walks its whole band at each checked LoD, and
+//! the two buffers are compared where either one changed (they are equal
+//! before, so equal everywhere after). Cost per checked LoD: O(changes +
+//! the current band's size).
+
+use super::{Extractor, MtsModel};
+use crate::mesh::{is_degenerate, Mesh};
+use crate::strip::encode::RESTART_U32;
+use crate::strip::{canonical_triangle, decode_run};
+use std::collections::HashMap;
+use std::ops::Range;
+
+/// What [`verify`] found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct VerifyReport {
+    /// LoDs checked.
+    pub lods_checked: usize,
+    /// LoDs where the strips' triangles differ from the oracle's, or the
+    /// coherent buffer from the from-scratch buffer.
+    pub mismatches: usize,
+    /// The first failing LoD and what failed there.
+    pub first_mismatch: Option<(usize, String)>,
+}
+
+/// The LoDs to check: every one, or `n` spread evenly from 0 to `max_lod`
+/// (both ends included).
+#[must_use]
+pub fn spread_lods(max_lod: usize, n: Option<usize>) -> Vec<usize> {
+    match n {
+        None => (0..=max_lod).collect(),
+        Some(0) => Vec::new(),
+        Some(1) => vec![0],
+        Some(n) => {
+            let mut lods: Vec<usize> = (0..n)
+                .map(|i| ((i as f64 / (n - 1) as f64) * max_lod as f64).round() as usize)
+                .collect();
+            lods.dedup();
+            lods
+        }
+    }
+}
+
+/// Checks `model` at `lods` (ascending; values past `max_lod` are clamped)
+/// against the replay of its contraction sequence on `mesh`, and coherent
+/// against from-scratch extraction; see the module documentation.
+///
+/// `mesh` must be the mesh the model was built from (its vertices; its
+/// triangles in any order, e.g. [`MtsModel::mesh`]).
+///
+/// # Panics
+/// If `mesh` has another vertex count than the model's contraction
+/// sequence, or `lods` is not ascending.
+#[must_use]
+pub fn verify(model: &MtsModel, mesh: &Mesh, lods: &[usize]) -> VerifyReport {
+    assert!(
+        lods.windows(2).all(|w| w[0] <= w[1]),
+        "LoDs to verify must be ascending"
+    );
+    let mut oracle = Oracle::new(model, mesh);
+    let mut coherent = Extractor::new(model);
+    let mut scratch = Extractor::new(model);
+    let mut shadow = coherent.buffer().to_vec();
+    let mut tally = Tally::default();
+    for t in &oracle.current {
+        if !is_degenerate(*t) {
+            tally.add(*t, -1);
+        }
+    }
+    let mut report = VerifyReport {
+        lods_checked: 0,
+        mismatches: 0,
+        first_mismatch: None,
+    };
+    let mut decoded = Vec::new();
+    for &lod in lods {
+        let lod = lod.min(model.max_lod());
+        oracle.advance(lod, &mut tally);
+        coherent.set_lod(lod);
+        for r in coherent.dirty_ranges() {
+            decode_range(&shadow, r.clone(), &mut decoded);
+            for t in decoded.drain(..) {
+                tally.add(t, -1);
+            }
+            decode_range(coherent.buffer(), r.clone(), &mut decoded);
+            for t in decoded.drain(..) {
+                tally.add(t, 1);
+            }
+            shadow[r.clone()].copy_from_slice(&coherent.buffer()[r.clone()]);
+        }
+        scratch.set_lod_from_scratch(lod);
+        let mut problem = None;
+        if tally.nonzero != 0 {
+            problem = Some(format!(
+                "the strips draw {} oriented triangles in other numbers than the replay",
+                tally.nonzero
+            ));
+        } else if let Some(i) = first_difference(&coherent, &scratch) {
+            problem = Some(format!(
+                "coherent and from-scratch buffers differ at index {i}"
+            ));
+        } else if coherent.overflows() != 0 {
+            problem = Some(format!("{} strip walks overflowed", coherent.overflows()));
+        }
+        report.lods_checked += 1;
+        if let Some(p) = problem {
+            report.mismatches += 1;
+            if report.first_mismatch.is_none() {
+                report.first_mismatch = Some((lod, p));
+            }
+        }
+    }
+    report
+}
+
+/// First index where the two buffers differ, looked for where either
+/// extractor wrote last.
+fn first_difference(a: &Extractor<'_>, b: &Extractor<'_>) -> Option<usize> {
+    let (x, y) = (a.buffer(), b.buffer());
+    a.dirty_ranges()
+        .iter()
+        .chain(b.dirty_ranges())
+        .filter_map(|r| {
+            r.clone()
+                .zip(&x[r.clone()])
+                .zip(&y[r.clone()])
+                .find(|((_, p), q)| p != q)
+                .map(|((i, _), _)| i)
+        })
+        .min()
+}
+
+/// The oriented triangles of `buffer[range]`, runs split at restarts.
+fn decode_range(buffer: &[u32], range: Range<usize>, out: &mut Vec<[u32; 3]>) {
+    for run in buffer[range].split(|&i| i == RESTART_U32) {
+        decode_run(run, out);
+    }
+}
+
+/// Per oriented triangle (canonical rotation), drawn minus expected.
+#[derive(Default)]
+struct Tally {
+    count: HashMap<[u32; 3], i64>,
+    nonzero: usize,
+}
+
+impl Tally {
+    fn add(&mut self, t: [u32; 3], delta: i64) {
+        let c = self.count.entry(canonical_triangle(t)).or_insert(0);
+        let was = *c != 0;
+        *c += delta;
+        match (was, *c != 0) {
+            (false, true) => self.nonzero += 1,
+            (true, false) => self.nonzero -= 1,
+            _ => {}
+        }
+    }
+}
+
+/// The naive replay kept incrementally: every input triangle with its
+/// current vertices, and per vertex the triangles that name it.
+struct Oracle<'m> {
+    model: &'m MtsModel,
+    lod: usize,
+    current: Vec<[u32; 3]>,
+    incident: Vec<Vec<u32>>,
+}
+
+impl<'m> Oracle<'m> {
+    fn new(model: &'m MtsModel, mesh: &Mesh) -> Oracle<'m> {
+        let collapses = model.collapses();
+        assert_eq!(
+            mesh.vertex_count(),
+            collapses.vertex_count(),
+            "mesh of another model"
+        );
+        let vertices = collapses.vertex_count() + collapses.appended().len();
+        let mut incident = vec![Vec::new(); vertices];
+        for (i, t) in mesh.triangles.iter().enumerate() {
+            for &v in t {
+                incident[v as usize].push(i as u32);
+            }
+        }
+        Oracle {
+            model,
+            lod: 0,
+            current: mesh.triangles.clone(),
+            incident,
+        }
+    }
+
+    /// Applies contractions up to `lod`, moving each changed triangle's
+    /// contribution in `tally`.
+    fn advance(&mut self, lod: usize, tally: &mut Tally) {
+        let collapses = self.model.collapses();
+        let optimal = collapses.is_optimal_placement();
+        while self.lod < lod {
+            let i = self.lod;
+            let step = collapses.steps()[i];
+            let target = collapses.target(i);
+            self.move_vertex(step.removed, target, tally);
+            if optimal {
+                self.move_vertex(step.kept, target, tally);
+            }
+            self.lod += 1;
+        }
+    }
+
+    fn move_vertex(&mut self, from: u32, to: u32, tally: &mut Tally) {
+        if from == to {
+            return;
+        }
+        let list = std::mem::take(&mut self.incident[from as usize]);
+        let mut keep = Vec::with_capacity(list.len());
+        for ti in list {
+            let t = &mut self.current[ti as usize];
+            if is_degenerate(*t) || !t.contains(&from) {
+                continue;
+            }
+            tally.add(*t, 1);
+            for v in t.iter_mut() {
+                if *v == from {
+                    *v = to;
+                }
+            }
+            if !is_degenerate(*t) {
+                tally.add(*t, -1);
+                keep.push(ti);
+            }
+        }
+        self.incident[to as usize].extend(keep);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spread_lods_include_both_ends_once() {
+        assert_eq!(spread_lods(10, Some(3)), vec![0, 5, 10]);
+        assert_eq!(spread_lods(2, Some(5)), vec![0, 1, 2]);
+        assert_eq!(spread_lods(3, None), vec![0, 1, 2, 3]);
+        assert_eq!(spread_lods(7, Some(1)), vec![0]);
+    }
+}
