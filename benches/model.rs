@@ -1,14 +1,13 @@
-//! Criterion: the MTS model on the bunny (or a generated 70K icosphere when
-//! `../shared/models` is absent): building the graphs from strips and the
-//! contraction sequence (one band, and banded), extracting LoD 0 from
-//! scratch, and a linear sweep of 1,000 LoD steps with and without the
-//! coherence cache (divide by 1,000 for one step).
+//! Criterion: building the MTS model of the bunny (or a generated 70K
+//! icosphere when `../shared/models` is absent): the graphs from strips and
+//! the contraction sequence (one band, and banded), and the whole pipeline
+//! from the mesh. Extraction is in `benches/extract.rs`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mts::mesh::generate::Generated;
 use mts::mesh::io::{load, LoadOptions};
-use mts::model::{build, BuildOptions};
-use mts::{stripify, Extractor, Mesh, SimplifyOptions, StripifyOptions};
+use mts::model::{build, build_from_mesh, BuildOptions, PipelineOptions};
+use mts::{stripify, Mesh, SimplifyOptions, StripifyOptions};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -47,27 +46,13 @@ fn bench(c: &mut Criterion) {
             )
         });
     });
-    let model = build(&mesh, &strips, &collapses, &BuildOptions::default());
-    let mut ex = Extractor::new(&model);
-    group.sample_size(50);
-    group.bench_function("extract_lod0_from_scratch", |b| {
-        b.iter(|| ex.set_lod_from_scratch(black_box(0)));
-    });
-    // 1,000 consecutive LoDs from the middle of the sequence.
-    let start = model.max_lod() / 4;
-    let steps = 1000.min(model.max_lod() - start);
-    group.bench_function("linear_sweep_1000_coherent", |b| {
+    group.bench_function("pipeline_from_mesh", |b| {
         b.iter(|| {
-            for lod in start..start + steps {
-                ex.set_lod(black_box(lod));
-            }
-        });
-    });
-    group.bench_function("linear_sweep_1000_from_scratch", |b| {
-        b.iter(|| {
-            for lod in start..start + steps {
-                ex.set_lod_from_scratch(black_box(lod));
-            }
+            build_from_mesh(
+                black_box(&mesh),
+                &PipelineOptions::default(),
+                &mut |_, _| {},
+            )
         });
     });
     group.finish();

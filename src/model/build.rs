@@ -1044,6 +1044,60 @@ mod tests {
             .collect()
     }
 
+    /// The paper's Fig. 4 strip and contractions.
+    ///
+    /// The paper's vertex labels disagree between its LoD-0 list (0…6) and
+    /// its LoD-1 list (1…7), so its strip is taken as `1 2 3 4 5 6 7` and
+    /// its contractions as printed: `5 → 3`, `3 → 4`, `4 → 6`. A first
+    /// contraction `0 → 2` on a leading vertex reproduces the paper's
+    /// "the vertex at the beginning of the strip has changed".
+    ///
+    /// Where this model departs from the printed sequences, on purpose:
+    /// - the paper drops the dead first triangle and starts at vertex 1,
+    ///   which would flip every later triangle (each changes parity); the
+    ///   model keeps the vertex before it (`2 1 2 …`) so the winding stays;
+    /// - at `3 → 4` the paper prints `1 2 4 −1 4 6 7`; the model keeps the
+    ///   run contiguous (`… 4 4 4 6 7`), which sends as many indices and
+    ///   needs no restart (ties go to "contiguous").
+    #[test]
+    fn the_papers_figure_4_example() {
+        //   1---3---5---7        the strip 0? 1 2 3 4 5 6 7 over a row of
+        //  / \ / \ / \ /        quads; vertex 0 leads it
+        // 0---2---4---6
+        let positions = (0..8)
+            .map(|i| Vec3::new(i as f32, (i % 2) as f32, 0.0))
+            .collect();
+        let run: Vec<u32> = (0..8).collect();
+        let strips = Strips::from_runs([&run[..]], 8).unwrap();
+        let mesh = Mesh {
+            positions,
+            triangles: strips.triangles(),
+        };
+        let (model, collapses) = model_of(&mesh, &strips, &[(0, 2), (5, 3), (3, 4), (4, 6)]);
+        let seq = sequences(&mesh, &model, &collapses);
+        assert_eq!(seq[0], vec![0, 1, 2, 3, 4, 5, 6, 7]);
+        // LoD 1: triangle (2 1 2) dies; the start keeps its parity vertex.
+        assert_eq!(seq[1], vec![2, 1, 2, 3, 4, 5, 6, 7]);
+        // LoD 2: the paper's swap, "1 2 3 4 3 6 7".
+        assert_eq!(seq[2], vec![2, 1, 2, 3, 4, 3, 6, 7]);
+        // LoD 3: the paper's "1 2 4 -1 4 6 7", contiguous here.
+        assert_eq!(seq[3], vec![2, 1, 2, 4, 4, 4, 6, 7]);
+        // LoD 4: the paper's "1 2 6": the strip ends early (-3).
+        assert_eq!(seq[4], vec![2, 1, 2, 6]);
+        // The beginnings list changed at LoD 1, as in the paper.
+        let begins = model.begins_of(0);
+        assert_eq!(begins.len(), 2);
+        assert_eq!(model.begin_res[begins.start], 0);
+        assert_eq!(model.begin_res[begins.start + 1], 4);
+        // The -1 case itself: a longer gap before an even window makes the
+        // restart (one index) cheaper than the filler (three), and the next
+        // run starts at the vertex the last one ended on.
+        let (mesh, strips) = quad_row(4);
+        let (model, collapses) = model_of(&mesh, &strips, &[(3, 2), (4, 2), (5, 2), (6, 2)]);
+        let seq = sequences(&mesh, &model, &collapses);
+        assert_eq!(seq[4], vec![0, 1, 2, RESTART_U32, 2, 7, 8, 9]);
+    }
+
     #[test]
     fn a_vertex_visited_twice_gets_two_nodes() {
         // 0 1 2 1 3: the swap at 1 makes the strip visit vertex 1 twice.

@@ -31,6 +31,7 @@ mod build;
 mod extract;
 pub mod format;
 mod pipeline;
+pub mod sequence;
 mod verify;
 
 pub use build::{

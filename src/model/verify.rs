@@ -253,6 +253,46 @@ impl<'m> Oracle<'m> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::generate::Generated;
+    use crate::model::{build_from_mesh, PipelineOptions};
+
+    fn torus_model() -> (MtsModel, Mesh) {
+        let mesh: Mesh = "torus:2k".parse::<Generated>().unwrap().build();
+        let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
+        (model, mesh)
+    }
+
+    #[test]
+    fn a_sound_model_passes_at_every_lod() {
+        let (model, mesh) = torus_model();
+        let lods = spread_lods(model.max_lod(), None);
+        let report = verify(&model, &mesh, &lods);
+        assert_eq!(report.lods_checked, model.max_lod() + 1);
+        assert_eq!(report.mismatches, 0, "{:?}", report.first_mismatch);
+    }
+
+    #[test]
+    fn a_wrong_vertex_in_a_graph_is_caught() {
+        let (mut model, mesh) = torus_model();
+        // Node 5 names another vertex: the strips draw other triangles
+        // from LoD 0 until that node leaves the strip.
+        model.node_vertex[5] = model.node_vertex[5].wrapping_add(1) % mesh.vertex_count() as u32;
+        let report = verify(&model, &mesh, &spread_lods(model.max_lod(), Some(50)));
+        assert_eq!(report.lods_checked, 50);
+        assert!(report.mismatches >= 1);
+        let (lod, what) = report.first_mismatch.unwrap();
+        assert_eq!(lod, 0);
+        assert!(what.contains("oriented triangles"), "{what}");
+    }
+
+    #[test]
+    fn a_flipped_oracle_triangle_is_caught() {
+        let (model, mut mesh) = torus_model();
+        let t = &mut mesh.triangles[0];
+        t.swap(0, 1);
+        let report = verify(&model, &mesh, &[0]);
+        assert_eq!(report.mismatches, 1);
+    }
 
     #[test]
     fn spread_lods_include_both_ends_once() {

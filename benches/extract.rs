@@ -1,0 +1,77 @@
+//! Criterion: LoD extraction on the bunny (or a generated 70K icosphere when
+//! `../shared/models` is absent), the MTS paper's Table 2: the linear,
+//! exponential and random request sequences (1,000 requests each, see
+//! `mts::model::sequence`), with the coherence cache and from scratch, side
+//! by side in one group; plus LoD 0 from scratch and 1,000 consecutive LoDs
+//! (a step of one, the "linear sweep over all LoDs" case). Throughput is
+//! per LoD change.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mts::mesh::generate::Generated;
+use mts::mesh::io::{load, LoadOptions};
+use mts::model::{build_from_mesh, sequence, PipelineOptions};
+use mts::{Extractor, Mesh};
+use std::hint::black_box;
+use std::path::Path;
+
+fn input() -> (String, Mesh) {
+    let bunny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models/bunny.ply");
+    match load(&bunny, LoadOptions::default()) {
+        Ok((mesh, _)) => ("bunny".into(), mesh),
+        Err(e) => {
+            eprintln!("the bunny is missing ({e}); using icosphere:70k");
+            let g: Generated = "icosphere:70k".parse().expect("valid name");
+            ("icosphere:70k".into(), g.build())
+        }
+    }
+}
+
+const REQUESTS: usize = 1000;
+
+fn bench(c: &mut Criterion) {
+    let (name, mesh) = input();
+    let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
+    let max_lod = model.max_lod();
+    let start = max_lod / 4;
+    let sequences = [
+        ("linear", sequence::linear(max_lod, REQUESTS)),
+        (
+            "exponential",
+            sequence::exponential(model.triangle_counts(), REQUESTS),
+        ),
+        ("random", sequence::random(max_lod, REQUESTS, 1)),
+        (
+            "consecutive",
+            (start..(start + REQUESTS).min(max_lod + 1)).collect(),
+        ),
+    ];
+    let mut ex = Extractor::new(&model);
+    let mut group = c.benchmark_group(format!("extract/{name}"));
+    group.sample_size(50);
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("lod0_from_scratch", |b| {
+        b.iter(|| ex.set_lod_from_scratch(black_box(0)));
+    });
+    group.sample_size(10);
+    for (seq, lods) in &sequences {
+        group.throughput(Throughput::Elements(lods.len() as u64));
+        group.bench_function(format!("{seq}/coherent"), |b| {
+            b.iter(|| {
+                for &lod in lods {
+                    ex.set_lod(black_box(lod));
+                }
+            });
+        });
+        group.bench_function(format!("{seq}/from_scratch"), |b| {
+            b.iter(|| {
+                for &lod in lods {
+                    ex.set_lod_from_scratch(black_box(lod));
+                }
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,109 @@
+//! The `mts` command's model subcommands end to end: `build --json` keys,
+//! `extract` at a LoD, triangle budget and ratio, `verify` passing on a
+//! sound model and failing (non-zero exit, named place) on a corrupt file.
+
+use serde_json::Value;
+use std::process::Command;
+
+fn mts(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_mts"))
+        .args(args)
+        .output()
+        .expect("the mts binary runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn json(text: &str) -> Value {
+    serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
+#[test]
+fn build_extract_verify_round_trip() {
+    let dir = std::env::temp_dir().join(format!("mts-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("torus.mts");
+    let file = file.to_str().unwrap();
+    let (ok, out, err) = mts(&["build", "--generated", "torus:5k", "-o", file, "--json"]);
+    assert!(ok, "{err}");
+    let b = json(&out);
+    let triangles = b["triangles"].as_u64().unwrap();
+    // The generator rounds to whole rings: 70 x 35 quads.
+    assert_eq!(triangles, 4900);
+    let vertices = b["vertices"].as_u64().unwrap();
+    assert_eq!(vertices, 2450);
+    assert_eq!(
+        b["raw_bytes"].as_u64().unwrap(),
+        12 * vertices + 12 * triangles
+    );
+    assert_eq!(
+        b["bytes"].as_u64().unwrap(),
+        std::fs::metadata(file).unwrap().len()
+    );
+    let max_lod = b["max_lod"].as_u64().unwrap();
+    assert!(max_lod > 2000, "a torus simplifies far: {max_lod}");
+    assert!(b["strips"].as_u64().unwrap() >= 1);
+    assert!(b["ms"].as_f64().unwrap() > 0.0);
+
+    let (ok, out, err) = mts(&["extract", file, "--lod", "0", "--json"]);
+    assert!(ok, "{err}");
+    let e = json(&out);
+    assert_eq!(e["lod"].as_u64(), Some(0));
+    assert_eq!(e["triangles"].as_u64(), Some(triangles));
+    let indices = e["indices"].as_u64().unwrap();
+    assert!(
+        indices > triangles && indices < triangles * 3 / 2,
+        "{indices}"
+    );
+    assert!(e["strips"].as_u64().unwrap() >= 1);
+    assert!(e["us"].as_f64().unwrap() > 0.0);
+
+    let (ok, out, _) = mts(&["extract", file, "--triangles", "1000", "--json"]);
+    assert!(ok);
+    let e = json(&out);
+    assert!(e["triangles"].as_u64().unwrap() <= 1000);
+    assert!(e["triangles"].as_u64().unwrap() >= 990);
+    let (ok, out, _) = mts(&["extract", file, "--ratio", "0.5", "--json"]);
+    assert!(ok);
+    assert!(json(&out)["triangles"].as_u64().unwrap() <= 2500);
+
+    let (ok, out, err) = mts(&["verify", file, "--lods", "all", "--json"]);
+    assert!(ok, "{err}");
+    let v = json(&out);
+    assert_eq!(v["lods_checked"].as_u64(), Some(max_lod + 1));
+    assert_eq!(v["mismatches"].as_u64(), Some(0));
+
+    // A flipped byte in the middle: the checksum catches it, the exit
+    // status says so and the message names the file.
+    let mut bytes = std::fs::read(file).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0x40;
+    let bad = dir.join("bad.mts");
+    std::fs::write(&bad, bytes).unwrap();
+    let (ok, _, err) = mts(&["verify", bad.to_str().unwrap(), "--json"]);
+    assert!(!ok);
+    assert!(err.contains("bad.mts"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn verify_takes_a_mesh_and_spread_lods() {
+    let (ok, out, err) = mts(&[
+        "verify",
+        "--generated",
+        "icosphere:3k",
+        "--lods",
+        "25",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v = json(&out);
+    assert_eq!(v["lods_checked"].as_u64(), Some(25));
+    assert_eq!(v["mismatches"].as_u64(), Some(0));
+    let (ok, _, err) = mts(&["verify", "--generated", "icosphere:3k", "--lods", "many"]);
+    assert!(!ok);
+    assert!(err.contains("--lods"), "{err}");
+}
