@@ -11,6 +11,11 @@ use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
 
+#[path = "mts/bench.rs"]
+mod bench;
+#[path = "mts/demo.rs"]
+mod demo;
+
 #[derive(Parser)]
 #[command(
     name = "mts",
@@ -24,6 +29,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job: build the model of the built-in mesh (or a file),
+    /// sweep its LoDs and print the side-by-side summary.
+    Demo(DemoArgs),
     /// Cut a mesh into triangle strips and compare with meshoptimizer's.
     Strips(StripsArgs),
     /// Record the quadric-error contraction sequence, take one LoD of it and
@@ -44,6 +52,75 @@ enum Command {
     /// Check a model against the replay oracle and coherent against
     /// from-scratch extraction; exits non-zero on any mismatch.
     Verify(VerifyArgs),
+    /// Measure the MTS paper's tables on this machine: report.md and
+    /// results.json.
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+struct DemoArgs {
+    #[command(flatten)]
+    source: MeshSource,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// Meshes, or folders whose .obj and .ply files are all measured.
+    /// Default: ../shared/models when it exists, else the built-in mesh.
+    #[arg(long, num_args = 1..)]
+    models: Vec<PathBuf>,
+    /// Where report.md and results.json go.
+    #[arg(long, default_value = "bench-report")]
+    out: PathBuf,
+    /// The built-in mesh only, fewer requests, no scale section (a smoke
+    /// test of under two minutes).
+    #[arg(long)]
+    quick: bool,
+}
+
+fn bench_cmd(args: &BenchArgs) -> Result<()> {
+    let mut models = Vec::new();
+    let mut sources = args.models.clone();
+    if sources.is_empty() && !args.quick {
+        let shared = PathBuf::from("../shared/models");
+        if shared.is_dir() {
+            sources.push(shared);
+        }
+    }
+    for p in sources {
+        if p.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(&p)
+                .with_context(|| format!("cannot read {}", p.display()))?
+                .flatten()
+                .map(|e| e.path())
+                .filter(|f| f.extension().is_some_and(|x| x == "obj" || x == "ply"))
+                .collect();
+            found.sort();
+            models.extend(found);
+        } else {
+            models.push(p);
+        }
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let t = Instant::now();
+    let options = bench::BenchOptions {
+        models,
+        quick: args.quick,
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+    };
+    let results = bench::run(&options, &|what| {
+        bar.set_message(format!("measuring {what}"))
+    })?;
+    bar.finish_and_clear();
+    bench::write(&args.out, &results)?;
+    println!(
+        "wrote {} and {} in {:.0} s",
+        args.out.join("report.md").display(),
+        args.out.join("results.json").display(),
+        t.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 #[derive(Args)]
@@ -492,6 +569,11 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Build(args) => build(args),
         Command::Info(args) => info(args),
         Command::Extract(args) => extract(args),
+        Command::Bench(args) => bench_cmd(args),
+        Command::Demo(args) => {
+            let (name, mesh, _) = args.source.load()?;
+            demo::run(&name, &mesh)
+        }
         Command::Verify(args) => {
             if verify(args)? {
                 Ok(())

@@ -1,0 +1,522 @@
+//! `mts bench`: the MTS paper's tables measured on this machine, written as
+//! `report.md` and `results.json` (schema in `docs/bench-schema.md`).
+//!
+//! Every figure of a row is measured in the same run as the figures it is
+//! compared with. Timings are medians of a few repetitions; the machine
+//! section names the CPU they come from.
+
+use anyhow::{Context, Result};
+use mts::distance::{surface_distance, Surface};
+use mts::model::{build_from_mesh, sequence, PipelineOptions};
+use mts::peers;
+use mts::strip::encode::RESTART_U32;
+use mts::{Extractor, Mesh, MtsModel};
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Version of `results.json`'s layout (`docs/bench-schema.md`).
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// Shares of the full triangle count reported in Tables 3–4.
+const SHARES: [f64; 6] = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
+/// Shares at which simplification quality is measured.
+const QUALITY_SHARES: [f64; 2] = [0.1, 0.01];
+/// Requests per Table 2 sequence (the full run; `--quick` uses fewer).
+const REQUESTS: usize = 1000;
+const QUICK_REQUESTS: usize = 200;
+/// Generated sizes of the scale section (triangles).
+const SCALE_SIZES: [&str; 6] = ["10k", "40k", "160k", "640k", "1M", "4M"];
+/// Surface samples per side for the quality section.
+const SAMPLES: usize = 100_000;
+
+/// What to measure.
+pub struct BenchOptions {
+    /// Meshes to measure (files); empty with `quick` means the built-in one.
+    pub models: Vec<PathBuf>,
+    /// The built-in mesh only, fewer requests, no scale section.
+    pub quick: bool,
+    /// The command line, for the report.
+    pub command: String,
+}
+
+/// Runs every section and returns `results.json`'s value; `progress` is
+/// told what is being measured.
+pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
+    let mut models = Vec::new();
+    let mut inputs: Vec<(String, Mesh)> = Vec::new();
+    if options.models.is_empty() {
+        let g = mts::mesh::generate::Generated::DEFAULT;
+        inputs.push((format!("generated {g}"), g.build()));
+    }
+    for path in &options.models {
+        let (mesh, _) = mts::mesh::io::load(path, Default::default())
+            .with_context(|| format!("cannot load {}", path.display()))?;
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        );
+        inputs.push((name, mesh));
+    }
+    let requests = if options.quick {
+        QUICK_REQUESTS
+    } else {
+        REQUESTS
+    };
+    for (name, mesh) in &inputs {
+        progress(name);
+        models.push(measure_model(name, mesh, requests)?);
+    }
+    let scale = if options.quick {
+        Value::Null
+    } else {
+        progress("scale");
+        measure_scale(progress)
+    };
+    Ok(json!({
+        "schema": SCHEMA_VERSION,
+        "command": options.command,
+        "quick": options.quick,
+        "machine": machine(),
+        "models": models,
+        "scale": scale,
+        "fast_simplification": Value::Null,
+    }))
+}
+
+/// CPU, cores and system of this machine; no graphics adapter is used by
+/// the sections measured here.
+fn machine() -> Value {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    let os = std::fs::read_to_string("/etc/os-release")
+        .ok()
+        .and_then(|s| {
+            s.lines().find(|l| l.starts_with("PRETTY_NAME=")).map(|l| {
+                l.trim_start_matches("PRETTY_NAME=")
+                    .trim_matches('"')
+                    .to_string()
+            })
+        })
+        .unwrap_or_else(|| std::env::consts::OS.into());
+    json!({
+        "cpu": cpu,
+        "cores": std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
+        "os": os,
+        "adapter": Value::Null,
+    })
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Median over `repeat` runs of `f`, in microseconds.
+fn time_us(repeat: usize, mut f: impl FnMut()) -> f64 {
+    median(
+        (0..repeat.max(1))
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64() * 1e6
+            })
+            .collect(),
+    )
+}
+
+fn measure_model(name: &str, mesh: &Mesh, requests: usize) -> Result<Value> {
+    let (model, _, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let file_bytes = model.to_bytes().len();
+    let stats = model.stats();
+    Ok(json!({
+        "name": name,
+        "triangles": mesh.triangle_count(),
+        "vertices": mesh.vertex_count(),
+        "strips": model.base_strips().run_count(),
+        "max_lod": model.max_lod(),
+        "bands": model.band_count(),
+        "bytes": {
+            "raw": model.raw_bytes(),
+            "raw_u16": model.raw_bytes_u16(),
+            "mts_file": file_bytes,
+            "mts_memory": stats.memory_bytes,
+        },
+        "build_ms": {
+            "stripify": ms(t.stripify),
+            "simplify": ms(t.simplify),
+            "model": ms(t.model),
+            "total": ms(t.total),
+        },
+        "extraction": measure_sequences(&model, requests),
+        "levels": measure_levels(&model),
+        "quality": measure_quality(mesh, &model),
+    }))
+}
+
+/// Table 2: microseconds per LoD change over each sequence, with the
+/// coherence cache and from scratch (median of three passes, each from a
+/// fresh extractor).
+fn measure_sequences(model: &MtsModel, requests: usize) -> Value {
+    let max_lod = model.max_lod();
+    let mut out = serde_json::Map::new();
+    for (seq, lods) in [
+        ("linear", sequence::linear(max_lod, requests)),
+        (
+            "exponential",
+            sequence::exponential(model.triangle_counts(), requests),
+        ),
+        ("random", sequence::random(max_lod, requests, 1)),
+    ] {
+        let n = lods.len().max(1) as f64;
+        let mut ex = Extractor::new(model);
+        let coherent = time_us(3, || {
+            ex = Extractor::new(model);
+            for &l in &lods {
+                ex.set_lod(l);
+            }
+        });
+        let scratch = time_us(3, || {
+            ex = Extractor::new(model);
+            for &l in &lods {
+                ex.set_lod_from_scratch(l);
+            }
+        });
+        // The extractor's construction is inside both timings; take it out.
+        let new = time_us(3, || ex = Extractor::new(model));
+        out.insert(
+            seq.into(),
+            json!({
+                "requests": lods.len(),
+                "mts_coherent_us": (coherent - new).max(0.0) / n,
+                "mts_scratch_us": (scratch - new).max(0.0) / n,
+            }),
+        );
+    }
+    Value::Object(out)
+}
+
+/// Tables 3–4: indices sent at each share — MTS strips (restart values
+/// included), the triangle list, meshoptimizer's strips of that level's
+/// mesh — with ACMR (16-entry FIFO) of each order.
+pub fn measure_levels(model: &MtsModel) -> Value {
+    let mesh = model.mesh();
+    let mut ex = Extractor::new(model);
+    let mut compact = Vec::new();
+    let levels: Vec<Value> = SHARES
+        .iter()
+        .map(|&share| {
+            let lod = model.lod_for_ratio(share);
+            let us = time_us(5, || {
+                ex.set_lod_from_scratch(lod);
+            });
+            ex.write_compact(&mut compact);
+            let level = model.collapses().mesh_at(&mesh, lod);
+            let mut strip_triangles = Vec::new();
+            for run in compact.split(|&i| i == RESTART_U32) {
+                mts::strip::decode_run(run, &mut strip_triangles);
+            }
+            let vertices = model.positions().len();
+            let list = meshopt::optimize_vertex_cache(&level.index_list(), level.vertex_count());
+            let list_triangles: Vec<[u32; 3]> =
+                list.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            let theirs = peers::meshopt::stripify(&level);
+            let triangles = model.triangle_count(lod);
+            json!({
+                "share": share,
+                "lod": lod,
+                "triangles": triangles,
+                "extract_us": us,
+                "mts_indices": ex.indices_sent(),
+                "list_indices": 3 * triangles,
+                "meshopt_strip_indices": theirs.restart_index_count(),
+                "mts_acmr": peers::meshopt::acmr(&strip_triangles, vertices),
+                "list_acmr": peers::meshopt::acmr(&list_triangles, level.vertex_count()),
+                "meshopt_strip_acmr": peers::meshopt::acmr(&theirs.triangles(), level.vertex_count()),
+            })
+        })
+        .collect();
+    Value::Array(levels)
+}
+
+/// Hausdorff and RMS (relative to the diagonal) of the project's LoD and
+/// of meshoptimizer's `simplify` at the same triangle count.
+fn measure_quality(mesh: &Mesh, model: &MtsModel) -> Value {
+    let ours_mesh = model.mesh();
+    let rows: Vec<Value> = QUALITY_SHARES
+        .iter()
+        .map(|&share| {
+            let lod = model.lod_for_ratio(share);
+            let ours = model.collapses().mesh_at(&ours_mesh, lod);
+            let t = Instant::now();
+            let theirs = peers::meshopt::simplify(mesh, ours.triangle_count());
+            let their_ms = t.elapsed().as_secs_f64() * 1e3;
+            let d = surface_distance(mesh.into(), (&ours).into(), SAMPLES);
+            let e = surface_distance(
+                mesh.into(),
+                Surface {
+                    positions: &mesh.positions,
+                    triangles: &theirs,
+                },
+                SAMPLES,
+            );
+            json!({
+                "share": share,
+                "mts": {"triangles": ours.triangle_count(), "hausdorff": d.hausdorff, "rms": d.rms},
+                "meshopt": {"triangles": theirs.len(), "hausdorff": e.hausdorff, "rms": e.rms, "ms": their_ms},
+            })
+        })
+        .collect();
+    Value::Array(rows)
+}
+
+/// Peak resident memory of this process so far (Linux), in bytes.
+fn peak_rss() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Build time, memory and extraction time of generated icospheres from
+/// 10K to 4M triangles, with the exponent of a power law fitted to each.
+fn measure_scale(progress: &dyn Fn(&str)) -> Value {
+    let mut rows = Vec::new();
+    for size in SCALE_SIZES {
+        let g: mts::mesh::generate::Generated = format!("icosphere:{size}")
+            .parse()
+            .expect("a valid generated name");
+        progress(&format!("scale icosphere:{size}"));
+        let mesh = g.build();
+        let (model, _, t) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
+        let mut ex = Extractor::new(&model);
+        let extract_us = time_us(5, || {
+            ex.set_lod_from_scratch(0);
+        });
+        rows.push(json!({
+            "triangles": mesh.triangle_count(),
+            "build_ms": t.total.as_secs_f64() * 1e3,
+            "model_bytes": model.stats().memory_bytes,
+            "peak_rss_bytes": peak_rss(),
+            "extract_lod0_us": extract_us,
+        }));
+    }
+    let fit = |key: &str| {
+        let points: Vec<(f64, f64)> = rows
+            .iter()
+            .filter_map(|r| Some((r["triangles"].as_f64()?, r[key].as_f64()?)))
+            .filter(|&(x, y)| x > 0.0 && y > 0.0)
+            .map(|(x, y)| (x.ln(), y.ln()))
+            .collect();
+        growth_exponent(&points)
+    };
+    json!({
+        "rows": rows,
+        "exponent": {
+            "build_ms": fit("build_ms"),
+            "model_bytes": fit("model_bytes"),
+            "extract_lod0_us": fit("extract_lod0_us"),
+        },
+    })
+}
+
+/// Least-squares slope of `(ln x, ln y)` points: the exponent `k` of
+/// `y ~ x^k`.
+fn growth_exponent(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 2 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &(x, y)| (a + x, b + y));
+    let (mx, my) = (sx / n, sy / n);
+    let (num, den) = points.iter().fold((0.0, 0.0), |(a, b), &(x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    (den > 0.0).then(|| num / den)
+}
+
+/// The Skip Strips and MTS figures the MTS paper prints for the bunny
+/// (Tables 3 and 4, 550 MHz Pentium III): triangles, Skip Strips vertices,
+/// MTS vertices. A printed reference, not a measurement.
+const PAPER_TABLE_3: [(&str, &str, &str); 3] = [
+    ("10.2K", "22K", "23K"),
+    ("50.8K", "83K", "71K"),
+    ("69.4K", "92K", "83K"),
+];
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap_or(f64::NAN)
+}
+
+/// `report.md` from the results.
+pub fn report(results: &Value) -> String {
+    let mut s = String::new();
+    let m = &results["machine"];
+    let _ = writeln!(s, "# mts bench report\n");
+    let _ = writeln!(
+        s,
+        "Command: `{}`. Machine: {} ({} cores), {}. Graphics adapter: none used by these sections (CPU only).\n",
+        results["command"].as_str().unwrap_or(""),
+        m["cpu"].as_str().unwrap_or("?"),
+        m["cores"],
+        m["os"].as_str().unwrap_or("?"),
+    );
+    let models = results["models"].as_array().cloned().unwrap_or_default();
+    let _ = writeln!(s, "## Table 1: models and sizes (bytes)\n");
+    let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | MTS in memory | build ms (stripify ‖ simplify, model, total) |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        let b = &r["bytes"];
+        let t = &r["build_ms"];
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
+            r["name"].as_str().unwrap_or("?"),
+            r["strips"],
+            r["triangles"],
+            r["vertices"],
+            f(&r["max_lod"]) as u64 + 1,
+            r["bands"],
+            b["raw"],
+            b["raw_u16"],
+            b["mts_file"],
+            f(&b["mts_file"]) / f(&b["raw"]),
+            b["mts_memory"],
+            f(&t["stripify"]),
+            f(&t["simplify"]),
+            f(&t["model"]),
+            f(&t["total"]),
+        );
+    }
+    let _ = writeln!(s, "\n## Table 2: microseconds per LoD change\n");
+    let _ = writeln!(s, "Sequences of `mts::model::sequence` (linear: coarsest to finest in equal steps; exponential: triangle counts in geometric steps; random: uniform, seed 1); medians of three passes.\n");
+    let _ = writeln!(s, "| model | linear coherent | linear without | × | exponential coherent | exponential without | × | random coherent | random without | × |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        let mut row = format!("| {} |", r["name"].as_str().unwrap_or("?"));
+        for seq in ["linear", "exponential", "random"] {
+            let e = &r["extraction"][seq];
+            let (c, w) = (f(&e["mts_coherent_us"]), f(&e["mts_scratch_us"]));
+            let _ = write!(row, " {c:.1} | {w:.1} | {:.1} |", w / c);
+        }
+        let _ = writeln!(s, "{row}");
+    }
+    let _ = writeln!(
+        s,
+        "\n## Tables 3–4: indices sent per level (ACMR, 16-entry FIFO)\n"
+    );
+    let _ = writeln!(s, "MTS strips with restart values, the triangle list (`optimize_vertex_cache` order) and meshoptimizer's strips of that level's mesh (`optimize_vertex_cache_strip` + `stripify`), measured on the same LoD.\n");
+    let _ = writeln!(s, "| model | share | triangles | MTS indices | list indices | meshopt strip indices | MTS / meshopt | ACMR MTS / list / meshopt strips | extract µs (from scratch) |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        for l in r["levels"].as_array().into_iter().flatten() {
+            let _ = writeln!(
+                s,
+                "| {} | {:.0}% | {} | {} | {} | {} | {:.3} | {:.3} / {:.3} / {:.3} | {:.1} |",
+                r["name"].as_str().unwrap_or("?"),
+                f(&l["share"]) * 100.0,
+                l["triangles"],
+                l["mts_indices"],
+                l["list_indices"],
+                l["meshopt_strip_indices"],
+                f(&l["mts_indices"]) / f(&l["meshopt_strip_indices"]),
+                f(&l["mts_acmr"]),
+                f(&l["list_acmr"]),
+                f(&l["meshopt_strip_acmr"]),
+                f(&l["extract_us"]),
+            );
+        }
+    }
+    let _ = writeln!(s, "\nPrinted reference, not measured here: the MTS paper's Table 3 for the bunny (vertices sent): Skip Strips / MTS —");
+    for (t, skip, ours) in PAPER_TABLE_3 {
+        let _ = write!(s, " {t} triangles: {skip} / {ours};");
+    }
+    let _ = writeln!(
+        s,
+        "\n\n## Quality: simplification error against meshoptimizer\n"
+    );
+    let _ = writeln!(s, "Hausdorff and RMS distance to the input relative to its bounding-box diagonal ({SAMPLES} samples per side), meshoptimizer's `simplify` asked for the same triangle count.\n");
+    let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts | Hausdorff meshopt | ratio | RMS mts | RMS meshopt |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        for q in r["quality"].as_array().into_iter().flatten() {
+            let _ = writeln!(
+                s,
+                "| {} | {:.0}% | {} / {} | {:.5} | {:.5} | {:.2} | {:.5} | {:.5} |",
+                r["name"].as_str().unwrap_or("?"),
+                f(&q["share"]) * 100.0,
+                q["mts"]["triangles"],
+                q["meshopt"]["triangles"],
+                f(&q["mts"]["hausdorff"]),
+                f(&q["meshopt"]["hausdorff"]),
+                f(&q["mts"]["hausdorff"]) / f(&q["meshopt"]["hausdorff"]),
+                f(&q["mts"]["rms"]),
+                f(&q["meshopt"]["rms"]),
+            );
+        }
+    }
+    if let Some(rows) = results["scale"]["rows"].as_array() {
+        let _ = writeln!(s, "\n## Scale: generated icospheres\n");
+        let _ = writeln!(s, "| triangles | build ms | model bytes | peak RSS bytes (process so far) | LoD 0 extraction µs |");
+        let _ = writeln!(s, "|---|---|---|---|---|");
+        for r in rows {
+            let _ = writeln!(
+                s,
+                "| {} | {:.0} | {} | {} | {:.0} |",
+                r["triangles"],
+                f(&r["build_ms"]),
+                r["model_bytes"],
+                r["peak_rss_bytes"],
+                f(&r["extract_lod0_us"]),
+            );
+        }
+        let e = &results["scale"]["exponent"];
+        let _ = writeln!(
+            s,
+            "\nFitted growth exponents (y ~ triangles^k): build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.",
+            f(&e["build_ms"]),
+            f(&e["model_bytes"]),
+            f(&e["extract_lod0_us"]),
+        );
+    }
+    s
+}
+
+/// Writes `report.md` and `results.json` into `dir` (created if needed).
+pub fn write(dir: &Path, results: &Value) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let json_path = dir.join("results.json");
+    std::fs::write(&json_path, serde_json::to_string_pretty(results)?)
+        .with_context(|| format!("cannot write {}", json_path.display()))?;
+    let md = dir.join("report.md");
+    std::fs::write(&md, report(results))
+        .with_context(|| format!("cannot write {}", md.display()))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn growth_exponent_recovers_a_power_law() {
+        let points: Vec<(f64, f64)> = [1e4, 1e5, 1e6]
+            .iter()
+            .map(|&x: &f64| (x.ln(), (3.0 * x.powf(1.25)).ln()))
+            .collect();
+        let k = growth_exponent(&points).unwrap();
+        assert!((k - 1.25).abs() < 1e-9, "{k}");
+        assert_eq!(growth_exponent(&points[..1]), None);
+    }
+}
