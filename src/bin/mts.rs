@@ -13,6 +13,8 @@ use std::time::Instant;
 
 #[path = "mts/bench.rs"]
 mod bench;
+#[path = "mts/charts.rs"]
+mod charts;
 #[path = "mts/demo.rs"]
 mod demo;
 

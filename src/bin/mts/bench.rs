@@ -499,9 +499,19 @@ pub fn write(dir: &Path, results: &Value) -> Result<()> {
     let json_path = dir.join("results.json");
     std::fs::write(&json_path, serde_json::to_string_pretty(results)?)
         .with_context(|| format!("cannot write {}", json_path.display()))?;
+    let charts = super::charts::write_all(dir, results)?;
+    let mut text = report(results);
+    if !charts.is_empty() {
+        let _ = writeln!(text, "\n## Charts\n");
+        for c in &charts {
+            if let Some(name) = c.file_name() {
+                let name = name.to_string_lossy();
+                let _ = writeln!(text, "![{name}]({name})\n");
+            }
+        }
+    }
     let md = dir.join("report.md");
-    std::fs::write(&md, report(results))
-        .with_context(|| format!("cannot write {}", md.display()))?;
+    std::fs::write(&md, text).with_context(|| format!("cannot write {}", md.display()))?;
     Ok(())
 }
 

@@ -1,0 +1,176 @@
+//! PNG charts of `mts bench`'s results (plotters, bitmap backend, DejaVu
+//! Sans embedded so no system font is needed).
+
+use anyhow::{anyhow, Result};
+use plotters::prelude::*;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+const SIZE: (u32, u32) = (900, 560);
+const FONT: &str = "sans-serif";
+
+fn register_font() {
+    // Registering twice replaces the same font: harmless.
+    let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
+}
+
+fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow!("chart: {e:?}")
+}
+
+/// Writes every chart the results allow into `dir`; returns their paths.
+pub fn write_all(dir: &Path, results: &Value) -> Result<Vec<PathBuf>> {
+    register_font();
+    let mut written = Vec::new();
+    let models = results["models"].as_array().cloned().unwrap_or_default();
+    // The bunny when measured, otherwise the first model.
+    if let Some(m) = models
+        .iter()
+        .find(|m| m["name"].as_str() == Some("bunny.ply"))
+        .or_else(|| models.first())
+    {
+        let path = dir.join("indices.png");
+        indices_chart(&path, m)?;
+        written.push(path);
+    }
+    if let Some(rows) = results["scale"]["rows"].as_array() {
+        let path = dir.join("scale.png");
+        scale_chart(&path, rows)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// Indices per triangle against the share of triangles (log axis): MTS
+/// strips, meshoptimizer's strips of each level, the triangle list.
+fn indices_chart(path: &Path, model: &Value) -> Result<()> {
+    let levels = model["levels"].as_array().cloned().unwrap_or_default();
+    let series = |key: &str| -> Vec<(f64, f64)> {
+        levels
+            .iter()
+            .filter_map(|l| {
+                let t = l["triangles"].as_f64()?;
+                Some((l["share"].as_f64()? * 100.0, l[key].as_f64()? / t.max(1.0)))
+            })
+            .collect()
+    };
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "Indices sent per triangle, {}",
+                model["name"].as_str().unwrap_or("?")
+            ),
+            (FONT, 22),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d((0.8f64..120.0).log_scale(), 0.8f64..3.2)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("share of the full triangle count (%)")
+        .y_desc("indices / triangle")
+        .label_style((FONT, 14))
+        .draw()
+        .map_err(err)?;
+    for (key, label, color) in [
+        ("mts_indices", "MTS strips (restart values included)", BLUE),
+        (
+            "meshopt_strip_indices",
+            "meshoptimizer strips of each level",
+            RED,
+        ),
+        ("list_indices", "triangle list", BLACK),
+    ] {
+        let points = series(key);
+        chart
+            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 14))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::MiddleRight)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Build milliseconds, model megabytes and LoD-0 extraction microseconds
+/// against triangles, log-log.
+fn scale_chart(path: &Path, rows: &[Value]) -> Result<()> {
+    let get = |key: &str, scale: f64| -> Vec<(f64, f64)> {
+        rows.iter()
+            .filter_map(|r| Some((r["triangles"].as_f64()?, r[key].as_f64()? * scale)))
+            .collect()
+    };
+    let all: Vec<(f64, f64)> = [
+        get("build_ms", 1.0),
+        get("model_bytes", 1e-6),
+        get("extract_lod0_us", 1.0),
+    ]
+    .concat();
+    let (x0, x1) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (y0, y1) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    if all.is_empty() {
+        return Ok(());
+    }
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption("Scale: generated icospheres", (FONT, 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            (x0 * 0.8..x1 * 1.25).log_scale(),
+            (y0.max(1e-3) * 0.5..y1 * 2.0).log_scale(),
+        )
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("triangles")
+        .label_style((FONT, 14))
+        .draw()
+        .map_err(err)?;
+    for (key, scale, label, color) in [
+        ("build_ms", 1.0, "build (ms)", BLUE),
+        ("model_bytes", 1e-6, "model in memory (MB)", RED),
+        ("extract_lod0_us", 1.0, "LoD 0 extraction (us)", GREEN),
+    ] {
+        let points = get(key, scale);
+        chart
+            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 14))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
