@@ -27,6 +27,8 @@ pub mod error;
 pub mod mesh;
 pub mod model;
 pub mod peers;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod simplify;
 pub mod strip;
 

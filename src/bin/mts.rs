@@ -11,6 +11,10 @@ use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
 
+#[cfg(feature = "render")]
+#[path = "mts/render.rs"]
+mod render;
+
 #[derive(Parser)]
 #[command(
     name = "mts",
@@ -39,6 +43,10 @@ enum Command {
     /// Describe an .mts file: sizes, bands, and strip quality at several
     /// LoDs against stripifying that LoD's mesh from scratch.
     Info(InfoArgs),
+    /// Draw one LoD headless (Mesa's lavapipe without a GPU) into a PNG,
+    /// by the MTS strips or the oracle triangle list.
+    #[cfg(feature = "render")]
+    Render(render::RenderArgs),
 }
 
 #[derive(Args)]
@@ -461,6 +469,8 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Convert(args) => convert(args),
         Command::Build(args) => build(args),
         Command::Info(args) => info(args),
+        #[cfg(feature = "render")]
+        Command::Render(args) => render::render(args),
     }
 }
 

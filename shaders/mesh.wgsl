@@ -1,0 +1,45 @@
+// The one pipeline of `StripRenderer` (strips and triangle lists alike):
+// positions through the caller's view-projection matrix, Lambert lighting
+// from one directional light on the interpolated vertex normals.
+
+struct Camera {
+    view_proj: mat4x4<f32>,
+    // xyz: unit direction towards the light (world space); w unused.
+    light_dir: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+
+struct VertexIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+};
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) normal: vec3<f32>,
+};
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    var out: VertexOut;
+    out.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
+    out.normal = v.normal;
+    return out;
+}
+
+const BASE_COLOUR: vec3<f32> = vec3<f32>(0.85, 0.78, 0.65);
+const AMBIENT: f32 = 0.18;
+
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    // A vertex without a triangle at LoD 0 has a zero normal: light it as
+    // if it faced the light rather than dividing by zero.
+    let len2 = dot(in.normal, in.normal);
+    var diffuse = 1.0;
+    if (len2 > 1e-20) {
+        diffuse = max(dot(in.normal * inverseSqrt(len2), camera.light_dir.xyz), 0.0);
+    }
+    let shade = AMBIENT + (1.0 - AMBIENT) * diffuse;
+    return vec4<f32>(BASE_COLOUR * shade, 1.0);
+}
