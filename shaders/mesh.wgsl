@@ -4,7 +4,8 @@
 
 struct Camera {
     view_proj: mat4x4<f32>,
-    // xyz: unit direction towards the light (world space); w unused.
+    // xyz: unit direction towards the light (world space); w: 1 to shade
+    // with it, 0 for the unlit base colour (coverage only).
     light_dir: vec4<f32>,
 };
 
@@ -37,6 +38,9 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     // if it faced the light rather than dividing by zero.
     let len2 = dot(in.normal, in.normal);
     var diffuse = 1.0;
+    if (camera.light_dir.w == 0.0) {
+        return vec4<f32>(BASE_COLOUR, 1.0);
+    }
     if (len2 > 1e-20) {
         diffuse = max(dot(in.normal * inverseSqrt(len2), camera.light_dir.xyz), 0.0);
     }

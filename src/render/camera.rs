@@ -7,13 +7,28 @@ use glam::camera::rh::proj::directx::perspective;
 use glam::camera::rh::view::look_at_mat4;
 use glam::{Mat4, Vec3};
 
-/// A view-projection matrix and the direction of the one light.
+/// A view-projection matrix, the direction of the one light and the
+/// shading.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     /// World to clip space (wgpu: x, y in -1..1, depth 0..1).
     pub view_proj: Mat4,
     /// Unit direction from the surface towards the light, world space.
     pub light_dir: Vec3,
+    /// Lit, or one flat colour.
+    pub shading: Shading,
+}
+
+/// How fragments are coloured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Shading {
+    /// Lambert lighting from the interpolated vertex normals.
+    #[default]
+    Lit,
+    /// The base colour everywhere: an image of coverage alone, which does
+    /// not depend on how the rasteriser interpolates (see `tests/render.rs`
+    /// for why that matters when comparing strips with lists).
+    Unlit,
 }
 
 /// Vertical field of view of [`Camera::framing`], radians (40°).
@@ -54,6 +69,7 @@ impl Camera {
         Camera {
             view_proj: proj * view,
             light_dir,
+            shading: Shading::Lit,
         }
     }
 

@@ -17,10 +17,13 @@ pub mod gpu;
 pub mod headless;
 pub mod strip_renderer;
 
-pub use camera::Camera;
+pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{HeadlessTarget, Image};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload};
+/// The wgpu this renderer is built with, so that embedders use the same
+/// version.
+pub use wgpu;
 
 use glam::Vec3;
 

@@ -9,7 +9,7 @@
 //! goes through one code path and a winding error shows as a hole. Indices
 //! are `u16` when every vertex index fits below the `u16` restart value.
 
-use super::camera::Camera;
+use super::camera::{Camera, Shading};
 use super::gpu::StripMode;
 use crate::model::Extractor;
 use crate::strip::encode::{stitch_restart_buffer, RESTART_U16, RESTART_U32};
@@ -277,7 +277,13 @@ impl StripRenderer {
     pub fn set_camera(&self, queue: &wgpu::Queue, camera: &Camera) {
         let u = CameraUniform {
             view_proj: camera.view_proj.to_cols_array_2d(),
-            light_dir: camera.light_dir.extend(0.0).to_array(),
+            light_dir: camera
+                .light_dir
+                .extend(match camera.shading {
+                    Shading::Lit => 1.0,
+                    Shading::Unlit => 0.0,
+                })
+                .to_array(),
         };
         queue.write_buffer(&self.uniform_buffer, 0, bytemuck::bytes_of(&u));
     }
