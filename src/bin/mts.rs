@@ -12,6 +12,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 #[cfg(feature = "render")]
+#[cfg(feature = "render")]
+#[path = "mts/bench.rs"]
+mod bench;
 #[path = "mts/render.rs"]
 mod render;
 
@@ -47,6 +50,11 @@ enum Command {
     /// by the MTS strips or the oracle triangle list.
     #[cfg(feature = "render")]
     Render(render::RenderArgs),
+    /// Measure throughput (`mts bench render`: frames and triangles per
+    /// second, strips against meshoptimizer-ordered lists).
+    #[cfg(feature = "render")]
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
 }
 
 #[derive(Args)]
@@ -471,6 +479,8 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Info(args) => info(args),
         #[cfg(feature = "render")]
         Command::Render(args) => render::render(args),
+        #[cfg(feature = "render")]
+        Command::Bench(command) => bench::bench(command),
     }
 }
 

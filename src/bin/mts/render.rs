@@ -34,7 +34,7 @@ pub enum StripModeArg {
 
 /// An image size `WxH`.
 #[derive(Clone, Copy)]
-pub struct Size(u32, u32);
+pub struct Size(pub u32, pub u32);
 
 impl std::str::FromStr for Size {
     type Err = String;
@@ -85,7 +85,7 @@ pub struct RenderArgs {
 
 /// The model of `source`: loaded from an .mts file, or built from the mesh
 /// (strips, contraction sequence, default options).
-fn model_of(source: &MeshSource) -> Result<(String, MtsModel)> {
+pub fn model_of(source: &MeshSource) -> Result<(String, MtsModel)> {
     if let Some(path) = &source.mesh {
         if path
             .extension()
