@@ -125,8 +125,23 @@ impl Gpu {
     /// Cost: blocks while the driver starts (tens of milliseconds on
     /// lavapipe, more on first use).
     pub fn new_headless() -> Result<Gpu> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Gpu::open(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+    }
+
+    /// [`Gpu::new_headless`] restricted to `backends` (e.g.
+    /// `wgpu::Backends::GL` to exercise the stitched path), whatever
+    /// `WGPU_BACKEND` says.
+    ///
+    /// # Errors
+    /// As [`Gpu::new_headless`].
+    pub fn new_headless_on(backends: wgpu::Backends) -> Result<Gpu> {
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        descriptor.backends = backends;
+        Gpu::open(descriptor)
+    }
+
+    fn open(descriptor: wgpu::InstanceDescriptor) -> Result<Gpu> {
+        let instance = wgpu::Instance::new(descriptor);
         let adapter = pollster::block_on(wgpu::util::initialize_adapter_from_env_or_default(
             &instance, None,
         ))
