@@ -12,9 +12,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 #[cfg(feature = "render")]
-#[cfg(feature = "render")]
 #[path = "mts/bench.rs"]
 mod bench;
+#[cfg(feature = "render")]
 #[path = "mts/render.rs"]
 mod render;
 
