@@ -1,4 +1,4 @@
-// The one pipeline of `StripRenderer` (strips and triangle lists alike):
+// The pipelines of `StripRenderer` (strips and triangle lists alike):
 // positions through the caller's view-projection matrix, Lambert lighting
 // from one directional light on the interpolated vertex normals.
 
@@ -14,6 +14,12 @@ struct Camera {
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
+    // Per instance: model to world (rotation, uniform scale, translation),
+    // by columns. A single object is one identity instance.
+    @location(2) model_0: vec4<f32>,
+    @location(3) model_1: vec4<f32>,
+    @location(4) model_2: vec4<f32>,
+    @location(5) model_3: vec4<f32>,
 };
 
 struct VertexOut {
@@ -24,8 +30,11 @@ struct VertexOut {
 @vertex
 fn vs_main(v: VertexIn) -> VertexOut {
     var out: VertexOut;
-    out.clip = camera.view_proj * vec4<f32>(v.position, 1.0);
-    out.normal = v.normal;
+    let model = mat4x4<f32>(v.model_0, v.model_1, v.model_2, v.model_3);
+    out.clip = camera.view_proj * (model * vec4<f32>(v.position, 1.0));
+    // Uniform scale only: the upper 3x3 keeps normals perpendicular, and
+    // the fragment stage normalises.
+    out.normal = (model * vec4<f32>(v.normal, 0.0)).xyz;
     return out;
 }
 

@@ -53,6 +53,10 @@ struct CameraUniform {
     light_dir: [f32; 4],
 }
 
+/// Bytes of one instance transform (a column-major `mat4x4<f32>`), the
+/// stride of vertex buffer slot 1.
+pub const INSTANCE_BYTES: u64 = 64;
+
 /// Interleaved vertex: position then normal (24 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -76,6 +80,8 @@ pub struct StripRenderer {
     config: RendererConfig,
     vertex_buffer: wgpu::Buffer,
     vertex_count: usize,
+    /// One identity transform: what [`StripRenderer::draw`] binds to slot 1.
+    identity_instance: wgpu::Buffer,
     uniform_buffer: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     strip_pipeline: wgpu::RenderPipeline,
@@ -145,6 +151,17 @@ impl StripRenderer {
             mapped_at_creation: false,
         });
         queue.write_buffer(&vertex_buffer, 0, vertex_bytes);
+        let identity_instance = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("mts identity instance"),
+            size: INSTANCE_BYTES,
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        queue.write_buffer(
+            &identity_instance,
+            0,
+            bytemuck::cast_slice(&glam::Mat4::IDENTITY.to_cols_array()),
+        );
         let uniform_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mts camera"),
             size: std::mem::size_of::<CameraUniform>() as u64,
@@ -210,6 +227,7 @@ impl StripRenderer {
             config: *config,
             vertex_buffer,
             vertex_count: positions.len(),
+            identity_instance,
             uniform_buffer,
             bind_group,
             strip_pipeline,
@@ -427,14 +445,23 @@ impl StripRenderer {
         if self.draw.is_empty() {
             return;
         }
-        pass.set_pipeline(match self.content {
-            Content::Strips => &self.strip_pipeline,
-            Content::List => &self.list_pipeline,
+        self.bind(pass, self.content == Content::Strips);
+        pass.set_vertex_buffer(1, self.identity_instance.slice(..));
+        pass.set_index_buffer(index_buffer.slice(..), self.index_format);
+        pass.draw_indexed(self.draw.clone(), 0, 0..1);
+    }
+
+    /// Sets the strip (`strips`) or list pipeline, the camera and the
+    /// vertices; the caller binds instances (slot 1) and indices, as
+    /// [`crate::render::scene`] does for many instances of one mesh.
+    pub(crate) fn bind(&self, pass: &mut wgpu::RenderPass<'_>, strips: bool) {
+        pass.set_pipeline(if strips {
+            &self.strip_pipeline
+        } else {
+            &self.list_pipeline
         });
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
-        pass.set_index_buffer(index_buffer.slice(..), self.index_format);
-        pass.draw_indexed(self.draw.clone(), 0, 0..1);
     }
 
     fn upload_stitched(
@@ -562,11 +589,20 @@ fn create_pipeline(
             module: shader,
             entry_point: Some("vs_main"),
             compilation_options: wgpu::PipelineCompilationOptions::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: std::mem::size_of::<Vertex>() as u64,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
-            })],
+            buffers: &[
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Vertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                }),
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: INSTANCE_BYTES,
+                    step_mode: wgpu::VertexStepMode::Instance,
+                    attributes: &wgpu::vertex_attr_array![
+                        2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x4
+                    ],
+                }),
+            ],
         },
         primitive,
         depth_stencil: config.depth_format.map(|format| wgpu::DepthStencilState {
