@@ -530,25 +530,15 @@ impl StripRenderer {
         if range.is_empty() {
             return Ok(Upload::default());
         }
-        let bytes = match self.index_format {
-            wgpu::IndexFormat::Uint32 => {
-                let data: &[u8] = bytemuck::cast_slice(&source[range.clone()]);
-                queue.write_buffer(buffer, (range.start * 4) as u64, data);
-                data.len()
-            }
-            wgpu::IndexFormat::Uint16 => {
-                let (start, end) = (range.start & !1, (range.end + 1) & !1);
-                self.scratch_u16.clear();
-                self.scratch_u16
-                    .extend((start..end).map(|i| match source.get(i) {
-                        Some(&v) if v != RESTART_U32 => v as u16,
-                        _ => RESTART_U16,
-                    }));
-                let data: &[u8] = bytemuck::cast_slice(&self.scratch_u16);
-                queue.write_buffer(buffer, (start * 2) as u64, data);
-                data.len()
-            }
-        };
+        let bytes = write_index_range(
+            queue,
+            buffer,
+            self.index_format,
+            source,
+            range.clone(),
+            range.start,
+            &mut self.scratch_u16,
+        );
         Ok(Upload { bytes, writes: 1 })
     }
 
@@ -556,6 +546,44 @@ impl StripRenderer {
         match self.index_format {
             wgpu::IndexFormat::Uint16 => 2,
             wgpu::IndexFormat::Uint32 => 4,
+        }
+    }
+}
+
+/// Writes `source[range]` (restart values [`RESTART_U32`]) into `buffer`
+/// of `format` starting at index `dest`, and returns the bytes written.
+/// With `u16` the write is widened to even index bounds (4-byte aligned):
+/// one index before when `dest` is odd and one after when the count is odd,
+/// both with their current values from `source` (a restart past its end),
+/// so the buffer keeps mirroring `source`; the caller makes sure `source`
+/// has the index before and `buffer` room for the one after.
+pub(crate) fn write_index_range(
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    format: wgpu::IndexFormat,
+    source: &[u32],
+    range: Range<usize>,
+    dest: usize,
+    scratch: &mut Vec<u16>,
+) -> usize {
+    match format {
+        wgpu::IndexFormat::Uint32 => {
+            let data: &[u8] = bytemuck::cast_slice(&source[range]);
+            queue.write_buffer(buffer, (dest * 4) as u64, data);
+            data.len()
+        }
+        wgpu::IndexFormat::Uint16 => {
+            let lead = dest & 1;
+            let count = (range.len() + lead + 1) & !1;
+            let first = range.start - lead;
+            scratch.clear();
+            scratch.extend((first..first + count).map(|i| match source.get(i) {
+                Some(&v) if v != RESTART_U32 => v as u16,
+                _ => RESTART_U16,
+            }));
+            let data: &[u8] = bytemuck::cast_slice(scratch);
+            queue.write_buffer(buffer, ((dest - lead) * 2) as u64, data);
+            data.len()
         }
     }
 }
