@@ -7,6 +7,8 @@ struct Camera {
     // xyz: unit direction towards the light (world space); w: 1 to shade
     // with it, 0 for the unlit base colour (coverage only).
     light_dir: vec4<f32>,
+    // rgb: base colour of the surface (linear); a unused.
+    colour: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -38,7 +40,6 @@ fn vs_main(v: VertexIn) -> VertexOut {
     return out;
 }
 
-const BASE_COLOUR: vec3<f32> = vec3<f32>(0.85, 0.78, 0.65);
 const AMBIENT: f32 = 0.18;
 
 @fragment
@@ -48,11 +49,11 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let len2 = dot(in.normal, in.normal);
     var diffuse = 1.0;
     if (camera.light_dir.w == 0.0) {
-        return vec4<f32>(BASE_COLOUR, 1.0);
+        return vec4<f32>(camera.colour.rgb, 1.0);
     }
     if (len2 > 1e-20) {
         diffuse = max(dot(in.normal * inverseSqrt(len2), camera.light_dir.xyz), 0.0);
     }
     let shade = AMBIENT + (1.0 - AMBIENT) * diffuse;
-    return vec4<f32>(BASE_COLOUR * shade, 1.0);
+    return vec4<f32>(camera.colour.rgb * shade, 1.0);
 }

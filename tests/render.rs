@@ -15,7 +15,10 @@ mod common;
 use mts::mesh::generate::Generated;
 use mts::model::{build, BuildOptions};
 use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
-use mts::render::{Camera, Gpu, Image, RendererConfig, Shading, StripMode, StripRenderer};
+use mts::render::{
+    Camera, FrameStats, Gpu, Image, InstancedScene, RendererConfig, Shading, StripMode,
+    StripRenderer,
+};
 use mts::{stripify, Error, Extractor, Mesh, MtsModel, SimplifyOptions, StripifyOptions};
 
 const WIDTH: u32 = 320;
@@ -316,4 +319,117 @@ fn gl_backend_stitches_and_covers_what_the_oracle_covers() {
         assert!(a.foreground_pixels() >= 8_000);
         assert_eq!(difference(&a, &b), (0, 0), "GL, LoD {lod}");
     }
+}
+
+/// Draws `scene` into `target` after updating it for `camera`.
+fn scene_image(
+    gpu: &Gpu,
+    target: &HeadlessTarget,
+    scene: &mut InstancedScene<'_>,
+    camera: &Camera,
+) -> (Image, FrameStats) {
+    let stats = scene.update(&gpu.queue, camera, HEIGHT as f32);
+    let image = target
+        .render_image(&gpu.device, &gpu.queue, |pass| scene.draw(pass))
+        .unwrap();
+    (image, stats)
+}
+
+#[test]
+fn scene_culls_and_updates_like_a_fresh_scene() {
+    let Some(gpu) = gpu() else { return };
+    let mesh: Mesh = "torus:2k".parse::<Generated>().unwrap().build();
+    let model = model_of(&mesh);
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let config = RendererConfig {
+        color_format: COLOR_FORMAT,
+        depth_format: Some(DEPTH_FORMAT),
+        strip_mode: StripMode::Restart,
+    };
+    let target = HeadlessTarget::new(d, WIDTH, HEIGHT).unwrap();
+    let mut scene = InstancedScene::new(d, q, &config, &model, 100).unwrap();
+    let centres: Vec<glam::Vec3> = scene.instances().iter().map(|i| i.centre).collect();
+    let radius = scene.instances()[0].radius;
+
+    // From high above the middle, everything is in view.
+    let (lo, hi) = centres.iter().fold(
+        (
+            glam::Vec3::splat(f32::INFINITY),
+            glam::Vec3::splat(f32::NEG_INFINITY),
+        ),
+        |(lo, hi), &c| (lo.min(c), hi.max(c)),
+    );
+    let all = Camera::framing(lo - radius, hi + radius, target.aspect());
+    let (image, stats) = scene_image(&gpu, &target, &mut scene, &all);
+    assert_eq!(stats.visible, 100);
+    // The ground fills the frame: the foreground is the instances.
+    let fg = image.foreground_pixels();
+    eprintln!("scene from above: {fg} instance pixels");
+    assert!(fg >= 5_000, "{fg}");
+
+    // Looking away from the field, nothing is.
+    let mid = (lo + hi) * 0.5;
+    let away = Camera::looking(
+        mid - glam::Vec3::X * 2.0 * (hi.x - lo.x + 10.0 * radius),
+        mid - glam::Vec3::X * 10.0 * (hi.x - lo.x + 10.0 * radius),
+        target.aspect(),
+        0.1,
+        1e4,
+    );
+    assert_eq!(scene.update(q, &away, HEIGHT as f32).visible, 0);
+
+    // Across the field from a corner: every instance whose centre projects
+    // inside the view is drawn, none behind the camera is, nearer ones get
+    // finer LoDs.
+    let across = scene.overview_camera(target.aspect());
+    let (image, stats) = scene_image(&gpu, &target, &mut scene, &across);
+    let visible = scene.visible().to_vec();
+    eprintln!(
+        "scene: {} of 100 instances visible, {} triangles, {} indices sent",
+        stats.visible, stats.triangles, stats.indices_sent
+    );
+    assert!(
+        0 < stats.visible && stats.visible < 100,
+        "{}",
+        stats.visible
+    );
+    let mut by_depth = Vec::new();
+    for (i, &c) in centres.iter().enumerate() {
+        let clip = across.view_proj * c.extend(1.0);
+        let inside = clip.w > 0.0
+            && clip.x.abs() < clip.w
+            && clip.y.abs() < clip.w
+            && (0.0..clip.w).contains(&clip.z);
+        let drawn = visible.contains(&(i as u32));
+        assert!(!inside || drawn, "instance {i} is in view but culled");
+        assert!(
+            clip.w > -radius || !drawn,
+            "instance {i} is behind but drawn"
+        );
+        if drawn {
+            by_depth.push((clip.w, scene.lod_of(i).unwrap()));
+        }
+    }
+    by_depth.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert!(
+        by_depth[0].1 < by_depth[by_depth.len() - 1].1,
+        "{by_depth:?}"
+    );
+
+    // The incremental path (after two other views) draws what a fresh
+    // scene draws for the same view.
+    let mut fresh = InstancedScene::new(d, q, &config, &model, 100).unwrap();
+    let (expected, fresh_stats) = scene_image(&gpu, &target, &mut fresh, &across);
+    assert_eq!(
+        fresh_stats,
+        FrameStats {
+            lod_changes: fresh_stats.lod_changes,
+            upload_bytes: fresh_stats.upload_bytes,
+            ..stats
+        }
+    );
+    let fg = image.foreground_pixels();
+    eprintln!("scene across: {fg} pixels differ from the top-left corner");
+    assert!(fg >= 10_000, "{fg}");
+    assert_eq!(difference(&image, &expected), (0, 0));
 }

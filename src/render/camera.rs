@@ -73,6 +73,21 @@ impl Camera {
         }
     }
 
+    /// A perspective camera at `eye` looking at `target` (+y up, vertical
+    /// field of view [`FRAMING_FOV_Y`]), depth range `near..far` in world
+    /// units, lit from over the viewer's left shoulder. Cost: O(1).
+    #[must_use]
+    pub fn looking(eye: Vec3, target: Vec3, aspect: f32, near: f32, far: f32) -> Camera {
+        let view = look_at_mat4(eye, target, Vec3::Y);
+        let proj = perspective(FRAMING_FOV_Y, aspect, near, far);
+        let dir = (eye - target).normalize_or(Vec3::Z);
+        Camera {
+            view_proj: proj * view,
+            light_dir: (dir + Vec3::new(-0.6, 0.8, 0.0)).normalize_or(Vec3::Y),
+            shading: Shading::Lit,
+        }
+    }
+
     /// [`Camera::framing`] of the bounding box of `positions` (a unit
     /// sphere at the origin when there are none). Cost: O(positions).
     #[must_use]

@@ -8,6 +8,8 @@
 //!   lists through one pipeline layout and one shader (`shaders/mesh.wgsl`).
 //! - [`headless`]: render to a texture, read it back, write a PNG.
 //! - [`camera`]: a default camera that frames a bounding box.
+//! - [`scene`]: many instances of one model, each with its own LoD and
+//!   coherence cache, frustum-culled.
 //!
 //! Nothing outside this module depends on it (see `../shared/DESIGN.md`,
 //! "Renderer"): the algorithm modules stay free of the GPU.
@@ -15,11 +17,13 @@
 pub mod camera;
 pub mod gpu;
 pub mod headless;
+pub mod scene;
 pub mod strip_renderer;
 
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{HeadlessTarget, Image};
+pub use scene::{FrameStats, Instance, InstancedScene};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload};
 /// The wgpu this renderer is built with, so that embedders use the same
 /// version.

@@ -51,7 +51,12 @@ enum Content {
 struct CameraUniform {
     view_proj: [[f32; 4]; 4],
     light_dir: [f32; 4],
+    colour: [f32; 4],
 }
+
+/// Surface colour of a new [`StripRenderer`] (linear RGB, a warm light
+/// grey).
+pub const DEFAULT_COLOUR: Vec3 = Vec3::new(0.85, 0.78, 0.65);
 
 /// Bytes of one instance transform (a column-major `mat4x4<f32>`), the
 /// stride of vertex buffer slot 1.
@@ -80,6 +85,8 @@ pub struct StripRenderer {
     config: RendererConfig,
     vertex_buffer: wgpu::Buffer,
     vertex_count: usize,
+    /// Linear RGB surface colour, written with the camera.
+    colour: Vec3,
     /// One identity transform: what [`StripRenderer::draw`] binds to slot 1.
     identity_instance: wgpu::Buffer,
     uniform_buffer: wgpu::Buffer,
@@ -227,6 +234,7 @@ impl StripRenderer {
             config: *config,
             vertex_buffer,
             vertex_count: positions.len(),
+            colour: DEFAULT_COLOUR,
             identity_instance,
             uniform_buffer,
             bind_group,
@@ -289,7 +297,13 @@ impl StripRenderer {
         (self.draw.end - self.draw.start) as usize
     }
 
-    /// Writes `camera` into the uniform buffer. Like every
+    /// Sets the surface colour (linear RGB, each 0..1) that the next
+    /// [`StripRenderer::set_camera`] writes; [`DEFAULT_COLOUR`] until then.
+    pub fn set_colour(&mut self, colour: Vec3) {
+        self.colour = colour;
+    }
+
+    /// Writes `camera` (and the surface colour) into the uniform buffer. Like every
     /// `queue.write_buffer`, it takes effect at the next submission, so one
     /// camera holds per submission.
     pub fn set_camera(&self, queue: &wgpu::Queue, camera: &Camera) {
@@ -302,6 +316,7 @@ impl StripRenderer {
                     Shading::Unlit => 0.0,
                 })
                 .to_array(),
+            colour: self.colour.extend(1.0).to_array(),
         };
         queue.write_buffer(&self.uniform_buffer, 0, bytemuck::bytes_of(&u));
     }
