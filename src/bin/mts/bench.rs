@@ -30,10 +30,17 @@ pub struct BenchRenderArgs {
     /// Image size in pixels.
     #[arg(long, default_value = "1024x768")]
     size: Size,
+    /// Instances of the model in the scene row (0 to skip it).
+    #[arg(long, default_value_t = 1000)]
+    scene: usize,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
 }
+
+/// The scene row refuses to hold more than this many bytes of per-instance
+/// coherence caches (4 bytes per slot index per instance).
+const SCENE_MEMORY_CAP: usize = 2 << 30;
 
 pub fn bench(command: &BenchCommand) -> Result<()> {
     match command {
@@ -153,10 +160,16 @@ fn bench_render(args: &BenchRenderArgs) -> Result<()> {
             }));
         }
     }
+    let scene = if args.scene > 0 {
+        Some(bench_scene(&gpu, &target, &config, &model, args)?)
+    } else {
+        None
+    };
     if args.json {
         println!(
             "{}",
             json!({
+                "scene": scene,
                 "input": name,
                 "adapter": report.name,
                 "backend": format!("{:?}", report.backend),
@@ -170,4 +183,70 @@ fn bench_render(args: &BenchRenderArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Median frame (update and draw) of `args.scene` instances seen by the
+/// scene's overview camera; prints a row unless `--json`.
+fn bench_scene(
+    gpu: &Gpu,
+    target: &HeadlessTarget,
+    config: &RendererConfig,
+    model: &mts::MtsModel,
+    args: &BenchRenderArgs,
+) -> Result<serde_json::Value> {
+    use mts::render::InstancedScene;
+    let per_instance = 4 * Extractor::new(model).buffer().len();
+    if per_instance * args.scene > SCENE_MEMORY_CAP {
+        anyhow::bail!(
+            "{} instances would hold {:.1} GB of coherence caches ({} bytes each); \
+             pass a smaller --scene",
+            args.scene,
+            (per_instance * args.scene) as f64 / 1e9,
+            per_instance
+        );
+    }
+    let config = RendererConfig {
+        strip_mode: mts::render::StripMode::Restart,
+        ..*config
+    };
+    let mut scene = InstancedScene::new(&gpu.device, &gpu.queue, &config, model, args.scene)?;
+    let camera = scene.overview_camera(target.aspect());
+    let height = target.size().1 as f32;
+    let t = Instant::now();
+    let first = scene.update(&gpu.queue, &camera, height);
+    let first_ms = t.elapsed().as_secs_f64() * 1e3;
+    let mut times = Vec::with_capacity(args.frames);
+    let mut stats = first;
+    for i in 0..args.frames + 2 {
+        let t = Instant::now();
+        stats = scene.update(&gpu.queue, &camera, height);
+        target.render(&gpu.device, &gpu.queue, |pass| scene.draw(pass))?;
+        if i >= 2 {
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let ms = times[times.len() / 2];
+    if !args.json {
+        println!(
+            "scene: {} instances, {} visible, {} triangles, {} indices sent; \
+             first update {first_ms:.1} ms; frame {ms:.2} ms = {:.1} fps, {:.2} Mtri/s",
+            args.scene,
+            stats.visible,
+            stats.triangles,
+            stats.indices_sent,
+            1e3 / ms,
+            stats.triangles as f64 / ms / 1e3
+        );
+    }
+    Ok(json!({
+        "instances": args.scene,
+        "visible": stats.visible,
+        "triangles": stats.triangles,
+        "indices_sent": stats.indices_sent,
+        "ms_first_update": first_ms,
+        "ms_per_frame": ms,
+        "fps": 1e3 / ms,
+        "triangles_per_second": stats.triangles as f64 * 1e3 / ms,
+    }))
 }
