@@ -120,6 +120,15 @@ pub enum Error {
     /// An argument is outside its documented domain.
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// No graphics adapter could be found (no GPU and no software driver
+    /// such as Mesa's lavapipe): callers that can do without rendering
+    /// (tests, benches) skip on this one.
+    #[error("no graphics adapter: {0}")]
+    NoAdapter(String),
+    /// The GPU refused an operation: device creation, a resource beyond the
+    /// adapter's limits, a failed readback.
+    #[error("GPU: {0}")]
+    Gpu(String),
 }
 
 /// `Result` with the crate's [`Error`].

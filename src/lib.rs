@@ -4,7 +4,9 @@
 //! into generalized triangle strips ([`stripify`], a STRIPE-style hybrid
 //! search), and measured against meshoptimizer ([`peers::meshopt`]). Later
 //! stages (simplification, the multiresolution model, the renderer) build
-//! on these types; see `ARCHITECTURE.md` and `../shared/DESIGN.md`.
+//! on these types; see `ARCHITECTURE.md` and `../shared/DESIGN.md`. The
+//! wgpu renderer (`render`, feature `render`, on by default) draws an
+//! [`Extractor`]'s output and uploads only the ranges a LoD change rewrote.
 //!
 //! ```
 //! use mts::mesh::generate::Generated;
@@ -27,6 +29,8 @@ pub mod error;
 pub mod mesh;
 pub mod model;
 pub mod peers;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod simplify;
 pub mod strip;
 

@@ -13,10 +13,16 @@ use std::time::Instant;
 
 #[path = "mts/bench.rs"]
 mod bench;
+#[cfg(feature = "render")]
+#[path = "mts/bench_render.rs"]
+mod bench_render;
 #[path = "mts/charts.rs"]
 mod charts;
 #[path = "mts/demo.rs"]
 mod demo;
+#[cfg(feature = "render")]
+#[path = "mts/render.rs"]
+mod render;
 
 #[derive(Parser)]
 #[command(
@@ -55,8 +61,12 @@ enum Command {
     /// from-scratch extraction; exits non-zero on any mismatch.
     Verify(VerifyArgs),
     /// Measure the MTS paper's tables on this machine: report.md and
-    /// results.json.
+    /// results.json (`mts bench render`: render throughput alone).
     Bench(BenchArgs),
+    /// Draw one LoD headless (Mesa's lavapipe without a GPU) into a PNG,
+    /// by the MTS strips or the oracle triangle list.
+    #[cfg(feature = "render")]
+    Render(render::RenderArgs),
 }
 
 #[derive(Args)]
@@ -66,7 +76,11 @@ struct DemoArgs {
 }
 
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true)]
 struct BenchArgs {
+    #[cfg(feature = "render")]
+    #[command(subcommand)]
+    command: Option<bench_render::BenchCommand>,
     /// Meshes, or folders whose .obj and .ply files are all measured.
     /// Default: ../shared/models when it exists, else the built-in mesh.
     #[arg(long, num_args = 1..)]
@@ -81,6 +95,10 @@ struct BenchArgs {
 }
 
 fn bench_cmd(args: &BenchArgs) -> Result<()> {
+    #[cfg(feature = "render")]
+    if let Some(command) = &args.command {
+        return bench_render::bench(command);
+    }
     let mut models = Vec::new();
     let mut sources = args.models.clone();
     if sources.is_empty() && !args.quick {
@@ -583,6 +601,8 @@ fn run(cli: &Cli) -> Result<()> {
                 bail!("the model breaks the invariant (see above)")
             }
         }
+        #[cfg(feature = "render")]
+        Command::Render(args) => render::render(args),
     }
 }
 

@@ -70,6 +70,30 @@ impl Strips {
     }
 }
 
+/// Re-encodes a restart-joined `u32` buffer (runs separated by
+/// [`RESTART_U32`], as [`crate::Extractor::buffer`] holds them, padding
+/// included) into one run without restart values, stitched the way
+/// [`Strips::to_stitched`] does; runs shorter than three indices draw
+/// nothing and are dropped. Writes into `out` (cleared first).
+///
+/// Cost: O(indices), no allocation beyond growing `out`.
+pub fn stitch_restart_buffer(buffer: &[u32], out: &mut Vec<u32>) {
+    out.clear();
+    for run in buffer.split(|&i| i == RESTART_U32) {
+        if run.len() < 3 {
+            continue;
+        }
+        if let Some(&last) = out.last() {
+            out.push(last);
+            out.push(run[0]);
+            if out.len() % 2 == 1 {
+                out.push(run[0]);
+            }
+        }
+        out.extend_from_slice(run);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,5 +132,18 @@ mod tests {
         decode_run(&stitched, &mut drawn);
         assert_eq!(drawn, s.triangles());
         assert!(!stitched.contains(&RESTART_U32));
+    }
+
+    #[test]
+    fn stitching_a_padded_restart_buffer_matches_to_stitched() {
+        let s = strips();
+        let mut padded = vec![RESTART_U32, RESTART_U32];
+        for run in s.runs() {
+            padded.extend_from_slice(run);
+            padded.extend([RESTART_U32, 7, RESTART_U32, RESTART_U32]);
+        }
+        let mut out = vec![42];
+        stitch_restart_buffer(&padded, &mut out);
+        assert_eq!(out, s.to_stitched());
     }
 }
