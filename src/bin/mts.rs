@@ -21,6 +21,9 @@ mod charts;
 #[path = "mts/demo.rs"]
 mod demo;
 #[cfg(feature = "render")]
+#[path = "mts/figure6.rs"]
+mod figure6;
+#[cfg(feature = "render")]
 #[path = "mts/render.rs"]
 mod render;
 
@@ -73,6 +76,9 @@ enum Command {
 struct DemoArgs {
     #[command(flatten)]
     source: MeshSource,
+    /// Where the strip of thumbnails (PNG) goes.
+    #[arg(long, default_value = "demo-thumbnails.png")]
+    thumbnails: PathBuf,
 }
 
 #[derive(Args)]
@@ -92,6 +98,9 @@ struct BenchArgs {
     /// test of under two minutes).
     #[arg(long)]
     quick: bool,
+    /// Skip Figure 6 (frames per second through the headless renderer).
+    #[arg(long)]
+    no_render: bool,
 }
 
 fn bench_cmd(args: &BenchArgs) -> Result<()> {
@@ -128,6 +137,7 @@ fn bench_cmd(args: &BenchArgs) -> Result<()> {
         models,
         quick: args.quick,
         command: std::env::args().collect::<Vec<_>>().join(" "),
+        render: !args.no_render,
     };
     let results = bench::run(&options, &|what| {
         bar.set_message(format!("measuring {what}"))
@@ -592,7 +602,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Bench(args) => bench_cmd(args),
         Command::Demo(args) => {
             let (name, mesh, _) = args.source.load()?;
-            demo::run(&name, &mesh)
+            demo::run(&name, &mesh, &args.thumbnails)
         }
         Command::Verify(args) => {
             if verify(args)? {

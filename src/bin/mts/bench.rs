@@ -39,6 +39,35 @@ pub struct BenchOptions {
     pub quick: bool,
     /// The command line, for the report.
     pub command: String,
+    /// Measure Figure 6 (frames per second) with the headless renderer.
+    pub render: bool,
+}
+
+/// Shares of Figure 6, and its timed frames per point.
+const FIGURE6_SHARES: [f64; 6] = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
+const QUICK_FIGURE6_SHARES: [f64; 3] = [1.0, 0.25, 0.05];
+const FIGURE6_FRAMES: usize = 10;
+const QUICK_FIGURE6_FRAMES: usize = 4;
+
+/// The headless renderer of Figure 6, when the build and the machine have
+/// one; otherwise why not.
+#[cfg(feature = "render")]
+type Figure6 = std::result::Result<super::figure6::Renderer, String>;
+#[cfg(not(feature = "render"))]
+type Figure6 = std::result::Result<std::convert::Infallible, String>;
+
+fn figure6_renderer(wanted: bool) -> Figure6 {
+    if !wanted {
+        return Err("not asked for (--no-render)".into());
+    }
+    #[cfg(feature = "render")]
+    {
+        super::figure6::Renderer::new().map_err(|e| format!("no adapter: {e:#}"))
+    }
+    #[cfg(not(feature = "render"))]
+    {
+        Err("built without the render feature".into())
+    }
 }
 
 /// Runs every section and returns `results.json`'s value; `progress` is
@@ -64,9 +93,17 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
     } else {
         REQUESTS
     };
+    let renderer = figure6_renderer(options.render);
+    let (shares, frames): (&[f64], usize) = if options.quick {
+        (&QUICK_FIGURE6_SHARES, QUICK_FIGURE6_FRAMES)
+    } else {
+        (&FIGURE6_SHARES, FIGURE6_FRAMES)
+    };
     for (name, mesh) in &inputs {
         progress(name);
-        models.push(measure_model(name, mesh, requests)?);
+        models.push(measure_model(
+            name, mesh, requests, &renderer, shares, frames,
+        )?);
     }
     let scale = if options.quick {
         Value::Null
@@ -78,16 +115,16 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
         "schema": SCHEMA_VERSION,
         "command": options.command,
         "quick": options.quick,
-        "machine": machine(),
+        "machine": machine(&renderer),
         "models": models,
         "scale": scale,
         "fast_simplification": Value::Null,
     }))
 }
 
-/// CPU, cores and system of this machine; no graphics adapter is used by
-/// the sections measured here.
-fn machine() -> Value {
+/// CPU, cores and system of this machine, and the graphics adapter of
+/// Figure 6 (`null` when none ran, with the reason in `adapter_note`).
+fn machine(renderer: &Figure6) -> Value {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
@@ -111,7 +148,14 @@ fn machine() -> Value {
         "cpu": cpu,
         "cores": std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
         "os": os,
-        "adapter": Value::Null,
+        "adapter": match renderer {
+            #[cfg(feature = "render")]
+            Ok(r) => Value::from(r.adapter()),
+            #[cfg(not(feature = "render"))]
+            Ok(never) => match *never {},
+            Err(_) => Value::Null,
+        },
+        "adapter_note": renderer.as_ref().err().cloned(),
     })
 }
 
@@ -133,7 +177,14 @@ fn time_us(repeat: usize, mut f: impl FnMut()) -> f64 {
     )
 }
 
-fn measure_model(name: &str, mesh: &Mesh, requests: usize) -> Result<Value> {
+fn measure_model(
+    name: &str,
+    mesh: &Mesh,
+    requests: usize,
+    renderer: &Figure6,
+    shares: &[f64],
+    frames: usize,
+) -> Result<Value> {
     let (model, _, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let file_bytes = model.to_bytes().len();
@@ -160,6 +211,16 @@ fn measure_model(name: &str, mesh: &Mesh, requests: usize) -> Result<Value> {
         "extraction": measure_sequences(&model, requests),
         "levels": measure_levels(&model),
         "quality": measure_quality(mesh, &model),
+        "figure6": match renderer {
+            #[cfg(feature = "render")]
+            Ok(r) => r.measure(&model, shares, frames)?,
+            #[cfg(not(feature = "render"))]
+            Ok(never) => match *never {},
+            Err(_) => {
+                let _ = (shares, frames);
+                Value::Null
+            }
+        },
     }))
 }
 
@@ -366,11 +427,15 @@ pub fn report(results: &Value) -> String {
     let _ = writeln!(s, "# mts bench report\n");
     let _ = writeln!(
         s,
-        "Command: `{}`. Machine: {} ({} cores), {}. Graphics adapter: none used by these sections (CPU only).\n",
+        "Command: `{}`. Machine: {} ({} cores), {}. Graphics adapter (Figure 6): {}.\n",
         results["command"].as_str().unwrap_or(""),
         m["cpu"].as_str().unwrap_or("?"),
         m["cores"],
         m["os"].as_str().unwrap_or("?"),
+        m["adapter"]
+            .as_str()
+            .or(m["adapter_note"].as_str())
+            .unwrap_or("none"),
     );
     let models = results["models"].as_array().cloned().unwrap_or_default();
     let _ = writeln!(s, "## Table 1: models and sizes (bytes)\n");
@@ -464,6 +529,46 @@ pub fn report(results: &Value) -> String {
                 f(&q["mts"]["rms"]),
                 f(&q["meshopt"]["rms"]),
             );
+        }
+    }
+    if models.iter().any(|r| r["figure6"].is_object()) {
+        let _ = writeln!(
+            s,
+            "\n## Figure 6: frames per second against the share of triangles\n"
+        );
+        let _ = writeln!(s, "Immediate: a LoD change (extraction and upload) before every frame. Per second: one extraction (MTS from scratch; the list replayed and put in meshoptimizer's cache order) and upload per second, drawing in between. The list is meshoptimizer-ordered; MTS draws strips with primitive restart.\n");
+        let _ = writeln!(s, "| model | share | triangles | MTS immediate | MTS per second | list immediate | list per second |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        for r in &models {
+            let rows = r["figure6"]["rows"].as_array().cloned().unwrap_or_default();
+            let mut shares: Vec<f64> = rows.iter().filter_map(|x| x["share"].as_f64()).collect();
+            shares.dedup();
+            for share in shares {
+                let fps = |method: &str, mode: &str| {
+                    rows.iter()
+                        .find(|x| {
+                            x["share"].as_f64() == Some(share)
+                                && x["method"] == method
+                                && x["mode"] == mode
+                        })
+                        .map_or(f64::NAN, |x| f(&x["fps"]))
+                };
+                let triangles = rows
+                    .iter()
+                    .find(|x| x["share"].as_f64() == Some(share))
+                    .map_or(Value::Null, |x| x["triangles"].clone());
+                let _ = writeln!(
+                    s,
+                    "| {} | {:.0}% | {} | {:.1} | {:.1} | {:.1} | {:.1} |",
+                    r["name"].as_str().unwrap_or("?"),
+                    share * 100.0,
+                    triangles,
+                    fps("mts", "immediate"),
+                    fps("mts", "per_second"),
+                    fps("list", "immediate"),
+                    fps("list", "per_second"),
+                );
+            }
         }
     }
     if let Some(rows) = results["scale"]["rows"].as_array() {

@@ -32,6 +32,11 @@ pub fn write_all(dir: &Path, results: &Value) -> Result<Vec<PathBuf>> {
         let path = dir.join("indices.png");
         indices_chart(&path, m)?;
         written.push(path);
+        if m["figure6"]["rows"].is_array() {
+            let path = dir.join("figure6.png");
+            figure6_chart(&path, m)?;
+            written.push(path);
+        }
     }
     if let Some(rows) = results["scale"]["rows"].as_array() {
         let path = dir.join("scale.png");
@@ -169,6 +174,73 @@ fn scale_chart(path: &Path, rows: &[Value]) -> Result<()> {
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
         .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Frames per second against the share of triangles (log axis), per
+/// method and mode: the MTS paper's Figure 6.
+fn figure6_chart(path: &Path, model: &Value) -> Result<()> {
+    let rows = model["figure6"]["rows"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let series = |method: &str, mode: &str| -> Vec<(f64, f64)> {
+        rows.iter()
+            .filter(|r| r["method"] == method && r["mode"] == mode)
+            .filter_map(|r| Some((r["share"].as_f64()? * 100.0, r["fps"].as_f64()?)))
+            .collect()
+    };
+    let top = rows
+        .iter()
+        .filter_map(|r| r["fps"].as_f64())
+        .fold(1.0f64, f64::max);
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "Frames per second, {}",
+                model["name"].as_str().unwrap_or("?")
+            ),
+            (FONT, 22),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d((0.8f64..120.0).log_scale(), 0.0..top * 1.15)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("share of the full triangle count (%)")
+        .y_desc("frames per second")
+        .label_style((FONT, 14))
+        .draw()
+        .map_err(err)?;
+    for (method, mode, label, color) in [
+        ("mts", "immediate", "MTS, extract + draw each frame", BLUE),
+        ("mts", "per_second", "MTS, one extraction per second", CYAN),
+        ("list", "immediate", "list, replayed each frame", RED),
+        ("list", "per_second", "list, one replay per second", MAGENTA),
+    ] {
+        let points = series(method, mode);
+        chart
+            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 14))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
         .draw()
         .map_err(err)?;
     root.present().map_err(err)?;

@@ -1,15 +1,24 @@
 //! `mts demo`: the first thing a new user runs. On the built-in mesh (or a
 //! file) it builds the model, sweeps the LoDs with and without the
-//! coherence cache, and prints the side-by-side summary: indices sent by
-//! MTS strips, a triangle list and meshoptimizer's strips of each level.
+//! coherence cache, renders a strip of thumbnails at several LoDs
+//! (headless), and prints the side-by-side summary: indices sent by MTS
+//! strips, a triangle list and meshoptimizer's strips of each level.
 
 use anyhow::Result;
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
 use mts::Extractor;
 use std::time::Instant;
 
-/// Runs the demo on `mesh` (named `name`) and prints its summary.
-pub fn run(name: &str, mesh: &mts::Mesh) -> Result<()> {
+/// Shares of the triangles shown as thumbnails, left to right.
+#[cfg(feature = "render")]
+const THUMBNAIL_SHARES: [f64; 5] = [1.0, 0.25, 0.05, 0.01, 0.002];
+/// Side of one thumbnail in pixels.
+#[cfg(feature = "render")]
+const THUMBNAIL: u32 = 256;
+
+/// Runs the demo on `mesh` (named `name`), prints its summary and writes
+/// the thumbnails to `thumbnails` (when the renderer is built in).
+pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result<()> {
     println!(
         "{name}: {} triangles, {} vertices",
         mesh.triangle_count(),
@@ -74,6 +83,62 @@ pub fn run(name: &str, mesh: &mts::Mesh) -> Result<()> {
             g("extract_us"),
         );
     }
+    #[cfg(feature = "render")]
+    match render_thumbnails(&model, thumbnails) {
+        Ok(line) => println!("\n{line}"),
+        Err(e) => println!("\nthumbnails skipped: {e:#}"),
+    }
+    #[cfg(not(feature = "render"))]
+    let _ = thumbnails;
     println!("\n(indices sent to the GPU per level: MTS strips with restart values, the triangle list, meshoptimizer's strips of that level's mesh; `mts bench` measures the full tables)");
     Ok(())
+}
+
+/// Draws the model's strips at [`THUMBNAIL_SHARES`] side by side into one
+/// PNG (headless; Mesa's lavapipe without a GPU) and says what it drew.
+#[cfg(feature = "render")]
+fn render_thumbnails(model: &mts::MtsModel, path: &std::path::Path) -> Result<String> {
+    use mts::render::headless::{HeadlessTarget, Image, COLOR_FORMAT, DEPTH_FORMAT};
+    use mts::render::{Camera, Gpu, RendererConfig, StripRenderer};
+    let gpu = Gpu::new_headless()?;
+    let report = gpu.report();
+    let config = RendererConfig {
+        color_format: COLOR_FORMAT,
+        depth_format: Some(DEPTH_FORMAT),
+        strip_mode: report.strip_mode,
+    };
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let mut renderer = StripRenderer::for_model(device, queue, &config, model)?;
+    let target = HeadlessTarget::new(device, THUMBNAIL, THUMBNAIL)?;
+    renderer.set_camera(queue, &Camera::framing_points(model.positions(), 1.0));
+    let n = THUMBNAIL_SHARES.len() as u32;
+    let mut strip = Image {
+        width: THUMBNAIL * n,
+        height: THUMBNAIL,
+        rgba: vec![0; (4 * THUMBNAIL * THUMBNAIL * n) as usize],
+    };
+    let mut ex = Extractor::new(model);
+    let mut labels = Vec::new();
+    // Coarse to fine would upload less; the order of the picture is fine to
+    // coarse, and every change uploads only its dirty ranges anyway.
+    for (i, &share) in THUMBNAIL_SHARES.iter().enumerate() {
+        let lod = model.lod_for_ratio(share);
+        ex.set_lod(lod);
+        renderer.upload_strips(device, queue, &ex)?;
+        let image = target.render_image(device, queue, |pass| renderer.draw(pass))?;
+        let row = 4 * THUMBNAIL as usize;
+        for y in 0..THUMBNAIL as usize {
+            let from = y * row;
+            let to = y * row * n as usize + i * row;
+            strip.rgba[to..to + row].copy_from_slice(&image.rgba[from..from + row]);
+        }
+        labels.push(format!("{} triangles", model.triangle_count(lod)));
+    }
+    strip.save_png(path)?;
+    Ok(format!(
+        "thumbnails ({}) on {}: {}",
+        labels.join(", "),
+        report.name,
+        path.display()
+    ))
 }

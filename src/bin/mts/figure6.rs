@@ -1,0 +1,179 @@
+//! The MTS paper's Figure 6 on the adapter at hand: frames per second
+//! against the share of triangles, for "extract then draw each frame"
+//! (immediate) and "one extraction per second", per method.
+//!
+//! - **mts**: immediate = each frame the coherent extractor moves one LoD
+//!   (back and forth around the level), the renderer uploads the dirty
+//!   ranges, then draws; per second = one extraction from scratch and a
+//!   full upload per second, drawing in between.
+//! - **list**: the triangle list of the level in meshoptimizer's
+//!   `optimize_vertex_cache` order. Immediate = each frame the list is
+//!   replayed from the contraction sequence (pc-rep) and uploaded, as a
+//!   program without a multiresolution structure would; per second = one
+//!   replay, reorder and upload per second.
+//!
+//! "Per second" frames are derived, not slept through: with extraction
+//! cost `e` ms and drawing cost `d` ms, a second holds `1 + (1000 − e) / d`
+//! frames.
+
+use anyhow::Result;
+use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
+use mts::render::{Camera, Gpu, RendererConfig, StripRenderer};
+use mts::{peers, Extractor, MtsModel};
+use serde_json::{json, Value};
+use std::time::Instant;
+
+/// Image size of the frames.
+const WIDTH: u32 = 800;
+const HEIGHT: u32 = 600;
+
+/// The renderer state shared by every model of a run.
+pub struct Renderer {
+    gpu: Gpu,
+    target: HeadlessTarget,
+    config: RendererConfig,
+}
+
+impl Renderer {
+    /// A headless device (lavapipe without a GPU) and its frame target.
+    pub fn new() -> Result<Renderer> {
+        let gpu = Gpu::new_headless()?;
+        let report = gpu.report();
+        let config = RendererConfig {
+            color_format: COLOR_FORMAT,
+            depth_format: Some(DEPTH_FORMAT),
+            strip_mode: report.strip_mode,
+        };
+        let target = HeadlessTarget::new(&gpu.device, WIDTH, HEIGHT)?;
+        Ok(Renderer {
+            gpu,
+            target,
+            config,
+        })
+    }
+
+    /// Adapter name, backend and strip mode, for the report.
+    pub fn adapter(&self) -> String {
+        self.gpu.report().to_string()
+    }
+
+    fn draw_ms(&self, renderer: &StripRenderer) -> Result<f64> {
+        let t = Instant::now();
+        self.target
+            .render(&self.gpu.device, &self.gpu.queue, |pass| {
+                renderer.draw(pass)
+            })?;
+        Ok(t.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// Figure 6 rows of `model` at `shares`, `frames` timed frames each.
+    pub fn measure(&self, model: &MtsModel, shares: &[f64], frames: usize) -> Result<Value> {
+        let (d, q) = (&self.gpu.device, &self.gpu.queue);
+        let camera = Camera::framing_points(model.positions(), self.target.aspect());
+        let mut strips = StripRenderer::for_model(d, q, &self.config, model)?;
+        let mut list = StripRenderer::for_model(d, q, &self.config, model)?;
+        strips.set_camera(q, &camera);
+        list.set_camera(q, &camera);
+        let mesh = model.mesh();
+        let vertices = model.positions().len();
+        let mut ex = Extractor::new(model);
+        let mut rows = Vec::new();
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        for &share in shares {
+            let lod = model.lod_for_ratio(share);
+            let other = if lod < model.max_lod() {
+                lod + 1
+            } else {
+                lod - 1
+            };
+            let triangles = model.triangle_count(lod);
+            // mts, immediate.
+            ex.set_lod(lod);
+            strips.upload_strips(d, q, &ex)?;
+            let mut immediate = Vec::with_capacity(frames);
+            for i in 0..frames + 2 {
+                let t = Instant::now();
+                ex.set_lod(if i % 2 == 0 { other } else { lod });
+                strips.update_strips(d, q, &ex)?;
+                self.target.render(d, q, |pass| strips.draw(pass))?;
+                if i >= 2 {
+                    immediate.push(t.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+            // mts, one extraction per second.
+            ex.set_lod(lod);
+            strips.update_strips(d, q, &ex)?;
+            let t = Instant::now();
+            let mut fresh = Extractor::new(model);
+            fresh.set_lod_from_scratch(lod);
+            strips.upload_strips(d, q, &fresh)?;
+            let extract_ms = t.elapsed().as_secs_f64() * 1e3;
+            let draw: Vec<f64> = (0..frames)
+                .map(|_| self.draw_ms(&strips))
+                .collect::<Result<_>>()?;
+            let mts_draw = median(draw);
+            // list, immediate: replay + upload + draw each frame.
+            let mut list_immediate = Vec::with_capacity(frames);
+            for i in 0..frames + 1 {
+                let t = Instant::now();
+                let tris = model.collapses().triangles_at(&mesh, lod);
+                list.upload_list(d, q, &tris)?;
+                self.target.render(d, q, |pass| list.draw(pass))?;
+                if i >= 1 {
+                    list_immediate.push(t.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+            // list, one replay + reorder + upload per second.
+            let t = Instant::now();
+            let tris = model.collapses().triangles_at(&mesh, lod);
+            let ordered = peers::meshopt::optimize_vertex_cache(&tris, vertices);
+            list.upload_list(d, q, &ordered)?;
+            let list_extract_ms = t.elapsed().as_secs_f64() * 1e3;
+            let draw: Vec<f64> = (0..frames)
+                .map(|_| self.draw_ms(&list))
+                .collect::<Result<_>>()?;
+            let list_draw = median(draw);
+            let per_second = |e: f64, d: f64| 1.0 + (1000.0 - e).max(0.0) / d;
+            for (method, mode, fps, indices) in [
+                (
+                    "mts",
+                    "immediate",
+                    1e3 / median(immediate),
+                    ex.indices_sent(),
+                ),
+                (
+                    "mts",
+                    "per_second",
+                    per_second(extract_ms, mts_draw),
+                    ex.indices_sent(),
+                ),
+                (
+                    "list",
+                    "immediate",
+                    1e3 / median(list_immediate),
+                    3 * triangles,
+                ),
+                (
+                    "list",
+                    "per_second",
+                    per_second(list_extract_ms, list_draw),
+                    3 * triangles,
+                ),
+            ] {
+                rows.push(json!({
+                    "share": share,
+                    "lod": lod,
+                    "triangles": triangles,
+                    "method": method,
+                    "mode": mode,
+                    "indices_sent": indices,
+                    "fps": fps,
+                }));
+            }
+        }
+        Ok(json!({ "width": WIDTH, "height": HEIGHT, "frames": frames, "rows": rows }))
+    }
+}
