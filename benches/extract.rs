@@ -6,30 +6,17 @@
 //! (a step of one, the "linear sweep over all LoDs" case). Throughput is
 //! per LoD change.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use mts::mesh::generate::Generated;
-use mts::mesh::io::{load, LoadOptions};
-use mts::model::{build_from_mesh, sequence, PipelineOptions};
-use mts::{Extractor, Mesh};
-use std::hint::black_box;
-use std::path::Path;
+mod common;
 
-fn input() -> (String, Mesh) {
-    let bunny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models/bunny.ply");
-    match load(&bunny, LoadOptions::default()) {
-        Ok((mesh, _)) => ("bunny".into(), mesh),
-        Err(e) => {
-            eprintln!("the bunny is missing ({e}); using icosphere:70k");
-            let g: Generated = "icosphere:70k".parse().expect("valid name");
-            ("icosphere:70k".into(), g.build())
-        }
-    }
-}
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mts::model::{build_from_mesh, sequence, PipelineOptions};
+use mts::Extractor;
+use std::hint::black_box;
 
 const REQUESTS: usize = 1000;
 
 fn bench(c: &mut Criterion) {
-    let (name, mesh) = input();
+    let (name, mesh) = common::bunny_or_generated();
     let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
     let max_lod = model.max_lod();
     let start = max_lod / 4;

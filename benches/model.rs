@@ -3,28 +3,15 @@
 //! the contraction sequence (one band, and banded), and the whole pipeline
 //! from the mesh. Extraction is in `benches/extract.rs`.
 
-use criterion::{criterion_group, criterion_main, Criterion};
-use mts::mesh::generate::Generated;
-use mts::mesh::io::{load, LoadOptions};
-use mts::model::{build, build_from_mesh, BuildOptions, PipelineOptions};
-use mts::{stripify, Mesh, SimplifyOptions, StripifyOptions};
-use std::hint::black_box;
-use std::path::Path;
+mod common;
 
-fn input() -> (String, Mesh) {
-    let bunny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models/bunny.ply");
-    match load(&bunny, LoadOptions::default()) {
-        Ok((mesh, _)) => ("bunny".into(), mesh),
-        Err(e) => {
-            eprintln!("the bunny is missing ({e}); using icosphere:70k");
-            let g: Generated = "icosphere:70k".parse().expect("valid name");
-            ("icosphere:70k".into(), g.build())
-        }
-    }
-}
+use criterion::{criterion_group, criterion_main, Criterion};
+use mts::model::{build, build_from_mesh, BuildOptions, PipelineOptions};
+use mts::{stripify, SimplifyOptions, StripifyOptions};
+use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {
-    let (name, mesh) = input();
+    let (name, mesh) = common::bunny_or_generated();
     let strips = stripify(&mesh, &StripifyOptions::default());
     let collapses = mts::simplify(&mesh, &SimplifyOptions::default()).collapses;
     let one_band = BuildOptions {

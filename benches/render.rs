@@ -6,26 +6,13 @@
 //! dirty-range upload). The adapter is printed first; without one the bench
 //! says so and measures nothing.
 
+mod common;
+
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use mts::mesh::generate::Generated;
-use mts::mesh::io::{load, LoadOptions};
 use mts::model::{build, BuildOptions};
 use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
 use mts::render::{Camera, Gpu, RendererConfig, StripRenderer};
-use mts::{peers, stripify, Extractor, Mesh, SimplifyOptions, StripifyOptions};
-use std::path::Path;
-
-fn input() -> (String, Mesh) {
-    let bunny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models/bunny.ply");
-    match load(&bunny, LoadOptions::default()) {
-        Ok((mesh, _)) => ("bunny".into(), mesh),
-        Err(e) => {
-            eprintln!("the bunny is missing ({e}); using icosphere:70k");
-            let g: Generated = "icosphere:70k".parse().expect("valid name");
-            ("icosphere:70k".into(), g.build())
-        }
-    }
-}
+use mts::{peers, stripify, Extractor, SimplifyOptions, StripifyOptions};
 
 fn bench(c: &mut Criterion) {
     let gpu = match Gpu::new_headless() {
@@ -37,7 +24,7 @@ fn bench(c: &mut Criterion) {
     };
     let report = gpu.report();
     eprintln!("adapter: {report}");
-    let (name, mesh) = input();
+    let (name, mesh) = common::bunny_or_generated();
     let strips = stripify(&mesh, &StripifyOptions::default());
     let collapses = mts::simplify(&mesh, &SimplifyOptions::default()).collapses;
     let model = build(&mesh, &strips, &collapses, &BuildOptions::default());

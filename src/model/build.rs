@@ -381,28 +381,25 @@ impl Part {
                 ((t & NODE_MASK) + node_base) | (t & RESTART)
             }
         };
-        model
-            .strip_nodes
-            .extend(self.strip_nodes[1..].iter().map(|&o| o + node_base));
-        model
-            .strip_begins
-            .extend(self.strip_begins[1..].iter().map(|&o| o + begin_base));
+        // Offset arrays start with 0, which the model already holds as its
+        // own last entry.
+        let offsets = |dst: &mut Vec<u32>, src: &[u32], base: u32| {
+            dst.extend(src[1..].iter().map(|&o| o + base));
+        };
+        offsets(&mut model.strip_nodes, &self.strip_nodes, node_base);
+        offsets(&mut model.strip_begins, &self.strip_begins, begin_base);
+        offsets(&mut model.node_arcs, &self.node_arcs, arc_base);
+        offsets(&mut model.band_strips, &self.band_strips, strip_base);
         model
             .begin_node
             .extend(self.begin_node.iter().map(|&t| shift(t)));
-        model.begin_res.extend_from_slice(&self.begin_res);
-        model.node_vertex.extend_from_slice(&self.node_vertex);
-        model
-            .node_arcs
-            .extend(self.node_arcs[1..].iter().map(|&o| o + arc_base));
         model
             .arc_target
             .extend(self.arc_target.iter().map(|&t| shift(t)));
+        model.begin_res.extend_from_slice(&self.begin_res);
+        model.node_vertex.extend_from_slice(&self.node_vertex);
         model.arc_res.extend_from_slice(&self.arc_res);
         model.band_lod.extend_from_slice(&self.band_lod);
-        model
-            .band_strips
-            .extend(self.band_strips[1..].iter().map(|&o| o + strip_base));
     }
 }
 

@@ -81,7 +81,7 @@ fn indices_chart(path: &Path, model: &Value) -> Result<()> {
         .label_style((FONT, 14))
         .draw()
         .map_err(err)?;
-    for (key, label, color) in [
+    let lines = [
         ("mts_indices", "MTS strips (restart values included)", BLUE),
         (
             "meshopt_strip_indices",
@@ -89,25 +89,11 @@ fn indices_chart(path: &Path, model: &Value) -> Result<()> {
             RED,
         ),
         ("list_indices", "triangle list", BLACK),
-    ] {
-        let points = series(key);
-        chart
-            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
-            .map_err(err)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-        chart
-            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
-            .map_err(err)?;
-    }
-    chart
-        .configure_series_labels()
-        .label_font((FONT, 14))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::MiddleRight)
-        .draw()
-        .map_err(err)?;
+    ]
+    .into_iter()
+    .map(|(key, label, color)| (label, color, series(key)))
+    .collect();
+    draw_lines(&mut chart, lines, SeriesLabelPosition::MiddleRight)?;
     root.present().map_err(err)?;
     Ok(())
 }
@@ -153,29 +139,15 @@ fn scale_chart(path: &Path, rows: &[Value]) -> Result<()> {
         .label_style((FONT, 14))
         .draw()
         .map_err(err)?;
-    for (key, scale, label, color) in [
+    let lines = [
         ("build_ms", 1.0, "build (ms)", BLUE),
         ("model_bytes", 1e-6, "model in memory (MB)", RED),
         ("extract_lod0_us", 1.0, "LoD 0 extraction (us)", GREEN),
-    ] {
-        let points = get(key, scale);
-        chart
-            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
-            .map_err(err)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-        chart
-            .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
-            .map_err(err)?;
-    }
-    chart
-        .configure_series_labels()
-        .label_font((FONT, 14))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(err)?;
+    ]
+    .into_iter()
+    .map(|(key, scale, label, color)| (label, color, get(key, scale)))
+    .collect();
+    draw_lines(&mut chart, lines, SeriesLabelPosition::UpperLeft)?;
     root.present().map_err(err)?;
     Ok(())
 }
@@ -219,13 +191,33 @@ fn figure6_chart(path: &Path, model: &Value) -> Result<()> {
         .label_style((FONT, 14))
         .draw()
         .map_err(err)?;
-    for (method, mode, label, color) in [
+    let lines = [
         ("mts", "immediate", "MTS, extract + draw each frame", BLUE),
         ("mts", "per_second", "MTS, one extraction per second", CYAN),
         ("list", "immediate", "list, replayed each frame", RED),
         ("list", "per_second", "list, one replay per second", MAGENTA),
-    ] {
-        let points = series(method, mode);
+    ]
+    .into_iter()
+    .map(|(method, mode, label, color)| (label, color, series(method, mode)))
+    .collect();
+    draw_lines(&mut chart, lines, SeriesLabelPosition::UpperRight)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Draws each `(label, colour, points)` as a line with dots, and the
+/// legend at `position`.
+fn draw_lines<'a, DB, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    series: Vec<(&'static str, RGBColor, Vec<(f64, f64)>)>,
+    position: SeriesLabelPosition,
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    for (label, color, points) in series {
         chart
             .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
             .map_err(err)?
@@ -240,9 +232,8 @@ fn figure6_chart(path: &Path, model: &Value) -> Result<()> {
         .label_font((FONT, 14))
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
+        .position(position)
         .draw()
         .map_err(err)?;
-    root.present().map_err(err)?;
     Ok(())
 }
