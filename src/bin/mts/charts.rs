@@ -205,11 +205,14 @@ fn figure6_chart(path: &Path, model: &Value) -> Result<()> {
     Ok(())
 }
 
+/// One line of a chart: its legend label, colour and points.
+type Line = (&'static str, RGBColor, Vec<(f64, f64)>);
+
 /// Draws each `(label, colour, points)` as a line with dots, and the
 /// legend at `position`.
 fn draw_lines<'a, DB, X, Y>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
-    series: Vec<(&'static str, RGBColor, Vec<(f64, f64)>)>,
+    series: Vec<Line>,
     position: SeriesLabelPosition,
 ) -> Result<()>
 where
