@@ -322,15 +322,17 @@ fn walk(model: &MtsModel, s: usize, lod: u32, out: &mut [u32]) -> Walk {
         return w;
     }
     let mut len = 0usize;
+    let mut n = (node & NODE_MASK) as usize;
+    let mut start = model.node_arcs[n] as usize;
     loop {
-        let n = (node & NODE_MASK) as usize;
         if len >= out.len() {
             w.overflow = true;
             break;
         }
         out[len] = model.node_vertex[n];
         len += 1;
-        let (mut a, end) = (model.node_arcs[n] as usize, model.node_arcs[n + 1] as usize);
+        let end = model.node_arcs[n + 1] as usize;
+        let mut a = start;
         while a < end && model.arc_res[a] < lod {
             w.from = w.from.max(model.arc_res[a] + 1);
             a += 1;
@@ -351,7 +353,18 @@ fn walk(model: &MtsModel, s: usize, lod: u32, out: &mut [u32]) -> Walk {
             out[len] = RESTART_U32;
             len += 1;
         }
-        node = t;
+        // Usually the next node is the next one stored, whose arcs start
+        // where this node's end: on that (predicted) branch the next
+        // iteration's loads do not wait for the target just loaded, which
+        // takes a load off the walk's dependency chain.
+        let next = (t & NODE_MASK) as usize;
+        if next == n + 1 {
+            n = next;
+            start = end;
+        } else {
+            n = next;
+            start = model.node_arcs[n] as usize;
+        }
     }
     w.len = len as u32;
     w
