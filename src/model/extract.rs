@@ -317,7 +317,7 @@ fn walk(model: &MtsModel, s: usize, lod: u32, out: &mut [u32]) -> Walk {
         return w;
     }
     w.to = w.to.min(model.begin_res[b]);
-    let mut node = model.begin_node[b];
+    let node = model.begin_node[b];
     if node == END {
         return w;
     }
