@@ -50,6 +50,10 @@ enum Command {
     /// by the MTS strips or the oracle triangle list.
     #[cfg(feature = "render")]
     Render(render::RenderArgs),
+    /// Open a window on a model (orbit camera; wheel, Up/Down change the
+    /// LoD, A toggles the automatic LoD, Escape quits).
+    #[cfg(feature = "viewer")]
+    View(render::ViewArgs),
     /// Measure throughput (`mts bench render`: frames and triangles per
     /// second, strips against meshoptimizer-ordered lists).
     #[cfg(feature = "render")]
@@ -481,6 +485,8 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Render(args) => render::render(args),
         #[cfg(feature = "render")]
         Command::Bench(command) => bench::bench(command),
+        #[cfg(feature = "viewer")]
+        Command::View(args) => render::view(args),
     }
 }
 

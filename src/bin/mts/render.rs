@@ -309,3 +309,28 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     }
     Ok(())
 }
+
+/// Arguments of `mts view`.
+#[cfg(feature = "viewer")]
+#[derive(Args)]
+pub struct ViewArgs {
+    /// An .mts model, or an OBJ/PLY mesh (the model is built on the fly).
+    #[command(flatten)]
+    source: MeshSource,
+    /// Show N instances on a ground plane instead (1000 when N is left out).
+    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000")]
+    scene: Option<usize>,
+}
+
+/// `mts view`: opens the viewer window.
+#[cfg(feature = "viewer")]
+pub fn view(args: &ViewArgs) -> Result<()> {
+    use mts::render::viewer::{run, ViewerContent};
+    let (name, model) = model_of(&args.source)?;
+    let content = match args.scene {
+        Some(n) => ViewerContent::Scene(n),
+        None => ViewerContent::Model,
+    };
+    run(&model, content, &format!("mts view: {name}"))?;
+    Ok(())
+}
