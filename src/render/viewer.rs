@@ -10,7 +10,7 @@
 //! and frames per second.
 
 use super::camera::Camera;
-use super::gpu::{AdapterReport, StripMode};
+use super::gpu::AdapterReport;
 use super::scene::{InstancedScene, PIXELS_PER_TRIANGLE};
 use super::strip_renderer::{RendererConfig, StripRenderer};
 use crate::model::Extractor;
@@ -278,11 +278,8 @@ impl<'m> State<'m> {
                 (drawn, (lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-6))
             }
             ViewerContent::Scene(n) => {
-                let scene_config = RendererConfig {
-                    strip_mode: StripMode::Restart,
-                    ..renderer_config
-                };
-                let scene = InstancedScene::new(&device, &queue, &scene_config, model, n)?;
+                // Needs primitive restart: on GL this is a clear error.
+                let scene = InstancedScene::new(&device, &queue, &renderer_config, model, n)?;
                 let (lo, hi) = scene.instances().iter().fold(
                     (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
                     |(lo, hi), i| (lo.min(i.centre), hi.max(i.centre)),

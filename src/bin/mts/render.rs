@@ -239,10 +239,11 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     let Size(width, height) = args.size;
     let gpu = Gpu::new_headless()?;
     let report = gpu.report();
+    // The scene needs primitive restart: on GL this is a clear error.
     let config = RendererConfig {
         color_format: COLOR_FORMAT,
         depth_format: Some(DEPTH_FORMAT),
-        strip_mode: StripMode::Restart,
+        strip_mode: report.strip_mode,
     };
     let (device, queue) = (&gpu.device, &gpu.queue);
     let target = HeadlessTarget::new(device, width, height)?;
