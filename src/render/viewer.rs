@@ -40,35 +40,64 @@ pub enum ViewerContent {
     Scene(usize),
 }
 
-/// Opens a window on `model` and runs until it is closed.
+/// What a viewer session did, for a closing line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewerReport {
+    /// The adapter that drew.
+    pub adapter: AdapterReport,
+    /// Frames presented.
+    pub frames: u64,
+    /// Seconds from the first frame to the last.
+    pub seconds: f64,
+    /// The last window title (triangles, indices, extraction, fps).
+    pub last_status: String,
+}
+
+/// Opens a window on `model` and runs until it is closed, or until
+/// `max_frames` frames were presented when given (for scripted runs).
 ///
 /// # Errors
 /// [`Error::Gpu`] when no window, surface, adapter or device can be
 /// created (no display, or no adapter that can present to it), and the
 /// errors of [`StripRenderer::for_model`] and [`InstancedScene::new`].
-pub fn run(model: &MtsModel, content: ViewerContent, title: &str) -> Result<()> {
+pub fn run(
+    model: &MtsModel,
+    content: ViewerContent,
+    title: &str,
+    max_frames: Option<u64>,
+) -> Result<ViewerReport> {
     let event_loop = EventLoop::new().map_err(|e| Error::Gpu(format!("no event loop: {e}")))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         model,
         content,
         title: title.to_owned(),
+        max_frames,
         state: None,
         error: None,
     };
     event_loop
         .run_app(&mut app)
         .map_err(|e| Error::Gpu(format!("event loop: {e}")))?;
-    match app.error {
-        Some(e) => Err(e),
-        None => Ok(()),
+    if let Some(e) = app.error {
+        return Err(e);
     }
+    let state = app
+        .state
+        .ok_or_else(|| Error::Gpu("the window never opened".into()))?;
+    Ok(ViewerReport {
+        adapter: state.report,
+        frames: state.total_frames,
+        seconds: state.started.elapsed().as_secs_f64(),
+        last_status: state.status,
+    })
 }
 
 struct App<'m> {
     model: &'m MtsModel,
     content: ViewerContent,
     title: String,
+    max_frames: Option<u64>,
     state: Option<State<'m>>,
     error: Option<Error>,
 }
@@ -90,8 +119,13 @@ struct State<'m> {
     dragging: bool,
     last_cursor: Option<(f64, f64)>,
     extract_us: f64,
+    /// Frames since the last title update, and that update's time.
     frames: u32,
     since: Instant,
+    total_frames: u64,
+    started: Instant,
+    /// What the title shows (kept here: not every platform reads it back).
+    status: String,
 }
 
 // One value per window, never moved around: the size difference is moot.
@@ -205,6 +239,9 @@ impl ApplicationHandler for App<'_> {
                     self.error = Some(e);
                     event_loop.exit();
                 }
+                if self.max_frames.is_some_and(|m| state.total_frames >= m) {
+                    event_loop.exit();
+                }
             }
             _ => {}
         }
@@ -312,6 +349,9 @@ impl<'m> State<'m> {
             extract_us: 0.0,
             frames: 0,
             since: Instant::now(),
+            total_frames: 0,
+            started: Instant::now(),
+            status: String::new(),
         })
     }
 
@@ -412,17 +452,19 @@ impl<'m> State<'m> {
         self.queue.submit([encoder.finish()]);
         self.queue.present(frame);
         self.frames += 1;
+        self.total_frames += 1;
         let elapsed = self.since.elapsed().as_secs_f64();
         if elapsed >= TITLE_PERIOD {
             let fps = f64::from(self.frames) / elapsed;
-            self.window.set_title(&format!(
+            self.status = format!(
                 "mts view: {triangles} triangles{}, {indices} indices sent, extraction {:.0} us, \
                  {fps:.0} fps ({}, {:?})",
                 if self.auto { " (auto)" } else { "" },
                 self.extract_us,
                 self.report.name,
                 self.report.backend
-            ));
+            );
+            self.window.set_title(&self.status);
             self.frames = 0;
             self.since = Instant::now();
         }

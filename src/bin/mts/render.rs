@@ -321,6 +321,9 @@ pub struct ViewArgs {
     /// Show N instances on a ground plane instead (1000 when N is left out).
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000")]
     scene: Option<usize>,
+    /// Quit after this many frames (scripted runs).
+    #[arg(long)]
+    frames: Option<u64>,
 }
 
 /// `mts view`: opens the viewer window.
@@ -332,6 +335,10 @@ pub fn view(args: &ViewArgs) -> Result<()> {
         Some(n) => ViewerContent::Scene(n),
         None => ViewerContent::Model,
     };
-    run(&model, content, &format!("mts view: {name}"))?;
+    let report = run(&model, content, &format!("mts view: {name}"), args.frames)?;
+    println!(
+        "{name}: {} frames in {:.1} s on {}; last: {}",
+        report.frames, report.seconds, report.adapter, report.last_status
+    );
     Ok(())
 }
