@@ -70,6 +70,10 @@ enum Command {
     /// by the MTS strips or the oracle triangle list.
     #[cfg(feature = "render")]
     Render(render::RenderArgs),
+    /// Open a window on a model (orbit camera; wheel, Up/Down change the
+    /// LoD, A toggles the automatic LoD, Escape quits).
+    #[cfg(feature = "viewer")]
+    View(render::ViewArgs),
 }
 
 #[derive(Args)]
@@ -613,6 +617,8 @@ fn run(cli: &Cli) -> Result<()> {
         }
         #[cfg(feature = "render")]
         Command::Render(args) => render::render(args),
+        #[cfg(feature = "viewer")]
+        Command::View(args) => render::view(args),
     }
 }
 

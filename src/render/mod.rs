@@ -10,6 +10,8 @@
 //! - [`camera`]: a default camera that frames a bounding box.
 //! - [`scene`]: many instances of one model, each with its own LoD and
 //!   coherence cache, frustum-culled.
+//! - `viewer` (feature `viewer`): a winit window with an orbit camera and
+//!   live LoD control (`mts view`).
 //!
 //! Nothing outside this module depends on it (see `../shared/DESIGN.md`,
 //! "Renderer"): the algorithm modules stay free of the GPU.
@@ -19,6 +21,8 @@ pub mod gpu;
 pub mod headless;
 pub mod scene;
 pub mod strip_renderer;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};

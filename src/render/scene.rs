@@ -1,6 +1,6 @@
 //! Many instances of one model on a ground plane, each with its own LoD
 //! (from its projected size) and its own coherence cache, culled against
-//! the view frustum.
+//! the view frustum through a BVH over their bounds (obvhs).
 //!
 //! Each instance owns an [`Extractor`] and a region of one shared index
 //! buffer as long as the model's widest band (the extractor's
@@ -79,6 +79,12 @@ pub struct InstancedScene<'m> {
     region: usize,
     index_buffer: wgpu::Buffer,
     instance_buffer: wgpu::Buffer,
+    /// BVH over the instances' bounding boxes (obvhs, built once): its
+    /// nodes and the instance indices its leaves point into.
+    bvh_nodes: Vec<obvhs::bvh2::node::Bvh2Node>,
+    bvh_instances: Vec<u32>,
+    /// Traversal stack of [`InstancedScene::cull`].
+    stack: Vec<u32>,
     /// Visible instances of the last update.
     visible: Vec<u32>,
     /// Extent of the field: min and max corner on the ground.
@@ -195,6 +201,19 @@ impl<'m> InstancedScene<'m> {
             mapped_at_creation: false,
         });
         queue.write_buffer(&instance_buffer, 0, bytemuck::cast_slice(&transforms));
+        let boxes: Vec<obvhs::aabb::Aabb> = instances
+            .iter()
+            .map(|i| {
+                let r = Vec3::splat(i.radius);
+                obvhs::aabb::Aabb::new((i.centre - r).into(), (i.centre + r).into())
+            })
+            .collect();
+        let mut build_time = std::time::Duration::ZERO;
+        let bvh = obvhs::bvh2::builder::build_bvh2(
+            &boxes,
+            obvhs::BvhBuildParams::fast_build(),
+            &mut build_time,
+        );
         Ok(InstancedScene {
             model,
             renderer,
@@ -205,6 +224,9 @@ impl<'m> InstancedScene<'m> {
             region,
             index_buffer,
             instance_buffer,
+            bvh_nodes: bvh.nodes,
+            bvh_instances: bvh.primitive_indices,
+            stack: Vec::new(),
             visible: Vec::with_capacity(count),
             field,
             scratch: Vec::new(),
@@ -255,15 +277,16 @@ impl<'m> InstancedScene<'m> {
         Camera::looking(eye, target, aspect, 0.01 * size, 2.0 * size)
     }
 
-    /// Culls the instances against `camera`'s frustum, gives each visible
+    /// Culls the instances against `camera`'s frustum (a BVH over their
+    /// bounding boxes, then each candidate's sphere), gives each visible
     /// instance the finest LoD with at most its projected disc area (in
     /// pixels of a viewport `viewport_height` pixels high) divided by
     /// [`PIXELS_PER_TRIANGLE`] triangles, extracts it through its own
     /// coherence cache and uploads what changed. Instances out of view keep
     /// their LoD and cost nothing. Also writes the camera.
     ///
-    /// Cost: O(instances) for culling, plus the extraction and upload of
-    /// the instances whose LoD changed.
+    /// Cost: O(visible · log instances) for culling, plus the extraction and
+    /// upload of the instances whose LoD changed.
     pub fn update(
         &mut self,
         queue: &wgpu::Queue,
@@ -280,12 +303,16 @@ impl<'m> InstancedScene<'m> {
         let row_w = camera.view_proj.row(3);
         let px_per_unit = row_y * 0.5 * viewport_height;
         let mut stats = FrameStats::default();
-        self.visible.clear();
-        for (i, inst) in self.instances.iter().enumerate() {
-            if !sphere_in_frustum(&planes, inst.centre, inst.radius) {
-                continue;
-            }
-            self.visible.push(i as u32);
+        cull(
+            &self.bvh_nodes,
+            &self.bvh_instances,
+            &self.instances,
+            &planes,
+            &mut self.stack,
+            &mut self.visible,
+        );
+        for &i in &self.visible {
+            let (i, inst) = (i as usize, &self.instances[i as usize]);
             let depth = row_w.dot(inst.centre.extend(1.0)).max(inst.radius);
             let r_px = inst.radius * px_per_unit / depth;
             let budget = (std::f32::consts::PI * r_px * r_px / PIXELS_PER_TRIANGLE) as usize;
@@ -402,6 +429,57 @@ fn frustum_planes(m: Mat4) -> [Vec4; 6] {
     })
 }
 
+/// Fills `visible` (ascending) with the instances whose bounding sphere
+/// meets the frustum: the BVH's boxes prune whole groups, each leaf's
+/// instances are tested by their spheres, so the result is the linear
+/// sphere test's.
+fn cull(
+    nodes: &[obvhs::bvh2::node::Bvh2Node],
+    leaves: &[u32],
+    instances: &[Instance],
+    planes: &[Vec4; 6],
+    stack: &mut Vec<u32>,
+    visible: &mut Vec<u32>,
+) {
+    visible.clear();
+    stack.clear();
+    if nodes.is_empty() {
+        return;
+    }
+    stack.push(0);
+    while let Some(n) = stack.pop() {
+        let node = &nodes[n as usize];
+        let aabb = node.aabb();
+        if !box_in_frustum(planes, aabb.min.into(), aabb.max.into()) {
+            continue;
+        }
+        if node.is_leaf() {
+            let first = node.first_index as usize;
+            for &p in &leaves[first..first + node.prim_count as usize] {
+                let inst = &instances[p as usize];
+                if sphere_in_frustum(planes, inst.centre, inst.radius) {
+                    visible.push(p);
+                }
+            }
+        } else {
+            stack.push(node.first_index);
+            stack.push(node.first_index + 1);
+        }
+    }
+    visible.sort_unstable();
+}
+
+/// Whether a box may meet the frustum: for each plane, the box corner
+/// farthest along its normal is inside (conservative: a box near a
+/// frustum corner may pass without meeting it).
+fn box_in_frustum(planes: &[Vec4; 6], min: Vec3, max: Vec3) -> bool {
+    planes.iter().all(|p| {
+        let n = p.truncate();
+        let corner = Vec3::select(n.cmpge(Vec3::ZERO), max, min);
+        n.dot(corner) + p.w >= 0.0
+    })
+}
+
 /// Whether a sphere is at least partly inside every plane.
 fn sphere_in_frustum(planes: &[Vec4; 6], centre: Vec3, radius: f32) -> bool {
     planes
@@ -412,6 +490,64 @@ fn sphere_in_frustum(planes: &[Vec4; 6], centre: Vec3, radius: f32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bvh_culling_equals_the_linear_test() {
+        // 30 x 30 unit spheres on a grid with varying heights and radii.
+        let instances: Vec<Instance> = (0..900)
+            .map(|i| {
+                let centre = Vec3::new(
+                    (i % 30) as f32 * 3.0,
+                    hash01(i) * 4.0,
+                    (i / 30) as f32 * 3.0,
+                );
+                Instance {
+                    transform: Mat4::from_translation(centre),
+                    centre,
+                    radius: 0.5 + hash01(i + 1000),
+                }
+            })
+            .collect();
+        let boxes: Vec<obvhs::aabb::Aabb> = instances
+            .iter()
+            .map(|i| {
+                let r = Vec3::splat(i.radius);
+                obvhs::aabb::Aabb::new((i.centre - r).into(), (i.centre + r).into())
+            })
+            .collect();
+        let mut t = std::time::Duration::ZERO;
+        let bvh =
+            obvhs::bvh2::builder::build_bvh2(&boxes, obvhs::BvhBuildParams::fast_build(), &mut t);
+        let (mut stack, mut visible) = (Vec::new(), Vec::new());
+        let mut seen = 0;
+        for k in 0..20u32 {
+            let eye = Vec3::new(
+                hash01(k) * 90.0,
+                2.0 + hash01(k + 50) * 20.0,
+                hash01(k + 99) * 90.0,
+            );
+            let target = Vec3::new(hash01(k + 7) * 90.0, 0.0, hash01(k + 13) * 90.0);
+            let cam = Camera::looking(eye, target, 1.5, 0.1, 60.0 + 40.0 * hash01(k + 3));
+            let planes = frustum_planes(cam.view_proj);
+            cull(
+                &bvh.nodes,
+                &bvh.primitive_indices,
+                &instances,
+                &planes,
+                &mut stack,
+                &mut visible,
+            );
+            let linear: Vec<u32> = (0..900u32)
+                .filter(|&i| {
+                    let inst = &instances[i as usize];
+                    sphere_in_frustum(&planes, inst.centre, inst.radius)
+                })
+                .collect();
+            assert_eq!(visible, linear, "camera {k}");
+            seen += visible.len();
+        }
+        assert!(seen > 500, "the cameras see something ({seen})");
+    }
 
     #[test]
     fn ground_faces_up() {
@@ -443,5 +579,21 @@ mod tests {
         ));
         // Straddling the left plane: kept.
         assert!(sphere_in_frustum(&planes, Vec3::new(-4.0, 0.0, -10.0), 1.0));
+        let unit = Vec3::ONE;
+        assert!(box_in_frustum(
+            &planes,
+            Vec3::new(0.0, 0.0, -10.0) - unit,
+            Vec3::new(0.0, 0.0, -10.0) + unit
+        ));
+        assert!(!box_in_frustum(
+            &planes,
+            Vec3::new(0.0, 0.0, 10.0) - unit,
+            Vec3::new(0.0, 0.0, 10.0) + unit
+        ));
+        assert!(!box_in_frustum(
+            &planes,
+            Vec3::new(50.0, 0.0, -10.0) - unit,
+            Vec3::new(50.0, 0.0, -10.0) + unit
+        ));
     }
 }
