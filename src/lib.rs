@@ -24,6 +24,7 @@
 
 pub mod distance;
 pub mod error;
+pub mod lod;
 pub mod mesh;
 pub mod model;
 pub mod peers;
@@ -31,6 +32,7 @@ pub mod simplify;
 pub mod strip;
 
 pub use error::{Error, Place, Result};
+pub use lod::{LodSource, Topology};
 pub use mesh::Mesh;
 pub use model::{Extractor, MtsModel};
 pub use simplify::{simplify, Collapses, SimplifyOptions};
