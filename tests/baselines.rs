@@ -6,7 +6,7 @@
 mod common;
 
 use common::{model, random_surface};
-use mts::baselines::ProgressiveMesh;
+use mts::baselines::{MultilevelMesh, ProgressiveMesh};
 use mts::mesh::generate::Generated;
 use mts::model::sequence;
 use mts::strip::sorted_canonical;
@@ -126,4 +126,98 @@ fn pm_file_round_trips_and_rejects_damage() {
             pm.validate();
         }
     }
+}
+
+#[test]
+fn multilevel_matches_the_oracle_at_every_lod_of_a_torus() {
+    let mesh = torus();
+    let c = collapses(&mesh);
+    for lods in orders(c.max_lod()) {
+        let mut ml = MultilevelMesh::new(&mesh, &c).unwrap();
+        ml.validate();
+        check_against_oracle(&mesh, &c, &mut ml, &lods);
+    }
+}
+
+#[test]
+fn switching_gives_the_same_buffer_as_from_scratch() {
+    let mesh = torus();
+    let c = collapses(&mesh);
+    let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
+    let mut ml = MultilevelMesh::new(&mesh, &c).unwrap();
+    for lod in sequence::random(c.max_lod(), 100, 3) {
+        pm.set_lod(lod);
+        ml.set_lod(lod);
+        let mut fresh_pm = ProgressiveMesh::new(&mesh, &c).unwrap();
+        let mut fresh_ml = MultilevelMesh::new(&mesh, &c).unwrap();
+        fresh_pm.set_lod(lod);
+        fresh_ml.set_lod(lod);
+        assert_eq!(pm.indices(), fresh_pm.indices(), "pm at LoD {lod}");
+        assert_eq!(ml.indices(), fresh_ml.indices(), "multilevel at LoD {lod}");
+        // Both keep the level order, so their buffers agree index for index.
+        assert_eq!(pm.indices(), ml.indices(), "pm and multilevel at LoD {lod}");
+    }
+}
+
+#[test]
+fn pm_and_multilevel_draw_what_mts_draws() {
+    let mesh = torus();
+    let c = collapses(&mesh);
+    let strips = mts::stripify(&mesh, &StripifyOptions::default());
+    let model = mts::model::build(&mesh, &strips, &c, &Default::default());
+    let mut ex = Extractor::new(&model);
+    let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
+    let mut ml = MultilevelMesh::new(&mesh, &c).unwrap();
+    for lod in 0..=c.max_lod() {
+        LodSource::set_lod(&mut ex, lod);
+        pm.set_lod(lod);
+        ml.set_lod(lod);
+        let want = sorted_canonical(&LodSource::triangles(&ex));
+        assert_eq!(sorted_canonical(&pm.triangles()), want, "pm at LoD {lod}");
+        assert_eq!(
+            sorted_canonical(&ml.triangles()),
+            want,
+            "multilevel at LoD {lod}"
+        );
+    }
+}
+
+#[test]
+fn multilevel_geomorph_ends_at_both_lods() {
+    let mesh = torus();
+    let c = collapses(&mesh);
+    let ml = MultilevelMesh::new(&mesh, &c).unwrap();
+    let (fine, coarse) = (100, 600);
+    let mut at = Vec::new();
+    ml.geomorph(fine, coarse, 1.0, &mut at).unwrap();
+    assert_eq!(at.len(), mesh.vertex_count() - fine);
+    assert_eq!(at, ml.positions()[..mesh.vertex_count() - fine]);
+    ml.geomorph(fine, coarse, 0.0, &mut at).unwrap();
+    // At t = 0 the fine triangles read through the coarse representatives:
+    // every vertex sits on a vertex of LoD `coarse`.
+    let coarse_vertices = &ml.positions()[..mesh.vertex_count() - coarse];
+    assert!(at.iter().all(|p| coarse_vertices.contains(p)));
+    let moved = at
+        .iter()
+        .zip(ml.positions())
+        .filter(|(a, b)| a != b)
+        .count();
+    // Exactly the vertices removed between the two LoDs move (a torus
+    // has no two vertices at one position).
+    assert_eq!(moved, coarse - fine);
+    ml.geomorph(fine, coarse, 0.5, &mut at).unwrap();
+    assert!(ml.geomorph(coarse, fine, 0.5, &mut at).is_err());
+    assert!(ml.geomorph(fine, coarse, 1.5, &mut at).is_err());
+}
+
+#[test]
+fn multilevel_memory_is_within_the_papers_bound() {
+    let mesh = torus();
+    let c = collapses(&mesh);
+    let ml = MultilevelMesh::new(&mesh, &c).unwrap();
+    let (v, t) = (mesh.vertex_count(), mesh.triangle_count());
+    // 16-bit indices: 12 per vertex, 6 per triangle, 2 per removed vertex.
+    assert_eq!(ml.raw_bytes(), 12 * v + 6 * t);
+    assert_eq!(ml.structure_bytes(), 12 * v + 6 * t + 2 * c.max_lod());
+    assert!(ml.structure_bytes() as f64 <= 1.1 * ml.raw_bytes() as f64);
 }

@@ -12,6 +12,8 @@
 
 mod bits;
 mod levels;
+pub mod multilevel;
 pub mod pm;
 
+pub use multilevel::MultilevelMesh;
 pub use pm::ProgressiveMesh;
