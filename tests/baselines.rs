@@ -6,7 +6,7 @@
 mod common;
 
 use common::{model, random_surface};
-use mts::baselines::{MultilevelMesh, ProgressiveMesh};
+use mts::baselines::{DiscreteLods, MultilevelMesh, ProgressiveMesh};
 use mts::mesh::generate::Generated;
 use mts::model::sequence;
 use mts::strip::sorted_canonical;
@@ -220,4 +220,38 @@ fn multilevel_memory_is_within_the_papers_bound() {
     assert_eq!(ml.raw_bytes(), 12 * v + 6 * t);
     assert_eq!(ml.structure_bytes(), 12 * v + 6 * t + 2 * c.max_lod());
     assert!(ml.structure_bytes() as f64 <= 1.1 * ml.raw_bytes() as f64);
+}
+
+#[test]
+fn discrete_answers_with_the_coarsest_level_above_the_budget() {
+    let mesh = torus();
+    let c = collapses(&mesh);
+    let mut d = DiscreteLods::new(&mesh, c.triangle_counts());
+    assert_eq!(d.level_triangles(0), 1936);
+    assert!(d.level_count() >= 4, "{} levels", d.level_count());
+    for l in 1..d.level_count() {
+        assert!(d.level_triangles(l) < d.level_triangles(l - 1));
+    }
+    assert_eq!(d.set_lod(0), 0);
+    assert_eq!(
+        d.dirty_ranges(),
+        &[0..3
+            * (0..d.level_count())
+                .map(|l| d.level_triangles(l))
+                .sum::<usize>()]
+    );
+    assert_eq!(
+        sorted_canonical(&d.triangles()),
+        sorted_canonical(&mesh.triangles)
+    );
+    for lod in [1, 500, c.max_lod()] {
+        d.set_lod(lod);
+        assert!(d.dirty_ranges().is_empty());
+        let level = d.level_for(lod);
+        assert!(d.triangle_count(lod) >= c.triangle_count(lod));
+        assert!(
+            level + 1 == d.level_count() || d.level_triangles(level + 1) < c.triangle_count(lod)
+        );
+        assert_eq!(d.indices().len(), 3 * d.level_triangles(level));
+    }
 }

@@ -11,9 +11,11 @@
 //!   stream.
 
 mod bits;
+pub mod discrete;
 mod levels;
 pub mod multilevel;
 pub mod pm;
 
+pub use discrete::DiscreteLods;
 pub use multilevel::MultilevelMesh;
 pub use pm::ProgressiveMesh;
