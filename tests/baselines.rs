@@ -6,7 +6,8 @@
 mod common;
 
 use common::{model, random_surface};
-use mts::baselines::{DiscreteLods, MultilevelMesh, ProgressiveMesh};
+use mts::baselines::cluster::stream;
+use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
 use mts::mesh::generate::Generated;
 use mts::model::sequence;
 use mts::strip::sorted_canonical;
@@ -254,4 +255,168 @@ fn discrete_answers_with_the_coarsest_level_above_the_budget() {
         );
         assert_eq!(d.indices().len(), 3 * d.level_triangles(level));
     }
+}
+
+#[test]
+fn cluster_tree_matches_its_own_replay_at_every_lod() {
+    let mesh = torus();
+    let tree = ClusterTree::new(&mesh).unwrap();
+    let c = tree.collapses().clone();
+    assert_eq!(c.max_lod(), mesh.vertex_count() - 1);
+    for i in 1..c.max_lod() {
+        assert!(tree.size(i - 1) <= tree.size(i));
+    }
+    for lods in orders(c.max_lod()) {
+        let mut t = tree.clone();
+        check_against_oracle(&mesh, &c, &mut t, &lods);
+    }
+    // Threshold selection: sizes below the threshold stay joined.
+    let s = tree.size(700);
+    let lod = tree.lod_for_size(s);
+    assert!(lod <= 700 && tree.size(lod) >= s && (lod == 0 || tree.size(lod - 1) < s));
+    assert_eq!(tree.lod_for_size(f32::INFINITY), c.max_lod());
+    assert_eq!(tree.lod_for_size(0.0), 0);
+}
+
+#[test]
+fn cluster_refine_then_simplify_returns_the_same_mesh() {
+    let mesh = torus();
+    let mut tree = ClusterTree::new(&mesh).unwrap();
+    for (coarse, fine) in [(900, 10), (500, 499), (967, 0), (300, 100)] {
+        tree.set_lod(coarse);
+        let before = tree.indices().to_vec();
+        tree.set_lod(fine);
+        assert_eq!(
+            sorted_canonical(&tree.triangles()),
+            sorted_canonical(&tree.collapses().triangles_at(&mesh, fine))
+        );
+        tree.set_lod(coarse);
+        assert_eq!(
+            tree.indices(),
+            &before[..],
+            "{coarse} -> {fine} -> {coarse}"
+        );
+    }
+}
+
+/// The decoded stream, mapped back to input numbering, is the input.
+fn assert_decodes_to(mesh: &Mesh, tree: &ClusterTree, d: &stream::Decoded) {
+    let order = tree.stream_order();
+    assert!(d.is_complete());
+    assert_eq!(d.positions.len(), mesh.vertex_count());
+    for (j, p) in d.positions.iter().enumerate() {
+        assert_eq!(*p, mesh.positions[order[j] as usize], "vertex {j}");
+    }
+    let back: Vec<[u32; 3]> = d
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| order[v as usize]))
+        .collect();
+    assert_eq!(sorted_canonical(&back), sorted_canonical(&mesh.triangles));
+}
+
+#[test]
+fn cluster_stream_decodes_to_the_mesh_and_every_prefix_is_valid() {
+    let mesh = torus();
+    let tree = ClusterTree::new(&mesh).unwrap();
+    let bytes = tree.to_stream();
+    let raw = 12 * mesh.vertex_count() + 6 * mesh.triangle_count();
+    assert!(bytes.len() < raw, "{} bytes against {raw} raw", bytes.len());
+    let full = stream::decode(&bytes, "torus.stream").unwrap();
+    assert_decodes_to(&mesh, &tree, &full);
+    assert_eq!(full.bytes_used, bytes.len());
+    assert_eq!(stream::decode_prefix(&bytes, "p").unwrap(), full);
+    let mut last = (0, 0);
+    for len in stream::HEADER_BYTES..=bytes.len() {
+        let d = stream::decode_prefix(&bytes[..len], "prefix").unwrap();
+        let m = d.mesh();
+        m.validate().unwrap();
+        // A prefix is a prefix: what it holds is the start of the full decode.
+        assert_eq!(d.positions, full.positions[..d.positions.len()]);
+        assert!(d.bytes_used <= len);
+        let now = (d.positions.len(), d.triangles.len());
+        assert!(now.0 >= last.0 && now.1 >= last.1);
+        last = now;
+        // Each triangle already decoded may still change vertex as later
+        // splits arrive, but it is never degenerate.
+        assert!(d.triangles.iter().all(|&t| !mts::mesh::is_degenerate(t)));
+    }
+    assert_eq!(last, (mesh.vertex_count(), mesh.triangle_count()));
+}
+
+#[test]
+fn cluster_prefix_with_whole_nodes_is_the_trees_lod() {
+    let mesh = torus();
+    let mut tree = ClusterTree::new(&mesh).unwrap();
+    let bytes = tree.to_stream();
+    let n = mesh.vertex_count();
+    for len in (stream::HEADER_BYTES..bytes.len()).step_by(211) {
+        let d = stream::decode_prefix(&bytes[..len], "prefix").unwrap();
+        let vertices = d.positions.len();
+        // Only a prefix whose last node has all its new triangles is a LoD.
+        let lod = n - vertices;
+        if d.triangles.len() != tree.triangle_count(lod) {
+            continue;
+        }
+        tree.set_lod(lod);
+        let order = tree.stream_order();
+        let back: Vec<[u32; 3]> = d
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| order[v as usize]))
+            .collect();
+        assert_eq!(
+            sorted_canonical(&back),
+            sorted_canonical(&tree.triangles()),
+            "{len} bytes, LoD {lod}"
+        );
+    }
+}
+
+#[test]
+fn corrupt_and_truncated_streams_get_clear_errors() {
+    let mesh = torus();
+    let tree = ClusterTree::new(&mesh).unwrap();
+    let bytes = tree.to_stream();
+    let e = stream::decode(&bytes[..10], "short.stream")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("short.stream") && e.contains("truncated"), "{e}");
+    assert!(stream::decode_prefix(&bytes[..10], "s").is_err());
+    for len in [stream::HEADER_BYTES, bytes.len() / 2, bytes.len() - 1] {
+        let e = stream::decode(&bytes[..len], "cut.stream")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("checksum") || e.contains("truncated"),
+            "{len}: {e}"
+        );
+    }
+    let mut magic = bytes.clone();
+    magic[3] = b'X';
+    assert!(stream::decode(&magic, "m")
+        .unwrap_err()
+        .to_string()
+        .contains("magic"));
+    let mut long = bytes.clone();
+    long.push(0);
+    assert!(stream::decode(&long, "l").is_err());
+    // A flipped bit anywhere in the body: the checksum catches it; the
+    // prefix decoder (no checksum) errors or yields a valid mesh.
+    for at in (stream::HEADER_BYTES..bytes.len()).step_by(37) {
+        let mut b = bytes.clone();
+        b[at] ^= 0x10;
+        let e = stream::decode(&b, "flip").unwrap_err().to_string();
+        assert!(e.contains("checksum"), "{e}");
+        if let Ok(d) = stream::decode_prefix(&b, "flip") {
+            d.mesh().validate().unwrap();
+        }
+    }
+    // Inconsistent header counts.
+    let mut counts = bytes.clone();
+    counts[16..20].copy_from_slice(&0u32.to_le_bytes());
+    assert!(stream::decode(&counts, "c")
+        .unwrap_err()
+        .to_string()
+        .contains("inconsistent"));
 }

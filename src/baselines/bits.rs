@@ -68,15 +68,6 @@ impl BitWriter {
         self.put(v & ((1u64 << n) - 1), n);
     }
 
-    /// Bits written so far.
-    pub(crate) fn bit_len(&self) -> u64 {
-        if self.used == 0 {
-            8 * self.bytes.len() as u64
-        } else {
-            8 * (self.bytes.len() as u64 - 1) + u64::from(self.used)
-        }
-    }
-
     /// The bytes, the last one zero-padded.
     pub(crate) fn finish(self) -> Vec<u8> {
         self.bytes
@@ -90,6 +81,9 @@ pub(crate) struct BitReader<'a> {
     /// Next bit to read.
     pos: u64,
     file: PathBuf,
+    /// Whether a read failed for lack of bits (a prefix decoder stops
+    /// quietly there; any other error is corruption).
+    pub(crate) ran_out: bool,
 }
 
 impl<'a> BitReader<'a> {
@@ -99,6 +93,7 @@ impl<'a> BitReader<'a> {
             bytes,
             pos: 0,
             file: PathBuf::from(file),
+            ran_out: false,
         }
     }
 
@@ -131,6 +126,7 @@ impl<'a> BitReader<'a> {
     /// [`Error::Parse`] ("truncated") when fewer bits remain.
     pub(crate) fn get(&mut self, width: u32, element: &str) -> Result<u64> {
         if self.remaining() < u64::from(width) {
+            self.ran_out = true;
             return Err(self.error(
                 element,
                 format!("truncated: {width} bits needed, {} left", self.remaining()),
@@ -231,7 +227,6 @@ mod tests {
         w.f32(-1.5);
         w.put(u64::MAX, 64);
         w.bit(true);
-        assert_eq!(w.bit_len(), 3 + 1 + 11 + 32 + 64 + 1);
         let bytes = w.finish();
         let mut r = BitReader::new(&bytes, "<memory>");
         assert_eq!(r.get(3, "a").unwrap(), 5);

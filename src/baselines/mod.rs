@@ -11,11 +11,13 @@
 //!   stream.
 
 mod bits;
+pub mod cluster;
 pub mod discrete;
 mod levels;
 pub mod multilevel;
 pub mod pm;
 
+pub use cluster::ClusterTree;
 pub use discrete::DiscreteLods;
 pub use multilevel::MultilevelMesh;
 pub use pm::ProgressiveMesh;

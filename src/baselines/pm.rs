@@ -39,20 +39,20 @@ pub const MAGIC: &[u8; 8] = b"MTSPM\0\0\x01";
 pub struct ProgressiveMesh {
     /// Positions in level order (vertex `v` is present at LoD `k` when
     /// `v < n - k`).
-    positions: Vec<Vec3>,
+    pub(crate) positions: Vec<Vec3>,
     /// Level index -> input vertex.
-    order: Vec<u32>,
+    pub(crate) order: Vec<u32>,
     /// Triangles at each LoD.
-    alive: Vec<u32>,
+    pub(crate) alive: Vec<u32>,
     /// Kept vertex of each contraction.
-    kept: Vec<u32>,
+    pub(crate) kept: Vec<u32>,
     /// Every triangle in level order with its vertices at the last LoD it
     /// is alive (the base mesh first, then the faces of each split).
-    faces: Vec<[u32; 3]>,
+    pub(crate) faces: Vec<[u32; 3]>,
     /// Step `i`'s corners are `corners[corner_start[i]..corner_start[i + 1]]`:
     /// list positions (`3 * triangle + corner`), ascending.
-    corner_start: Vec<u32>,
-    corners: Vec<u32>,
+    pub(crate) corner_start: Vec<u32>,
+    pub(crate) corners: Vec<u32>,
     /// The maintained triangle list (capacity for LoD 0).
     list: Vec<u32>,
     lod: Option<usize>,
@@ -171,7 +171,7 @@ impl ProgressiveMesh {
     }
 
     /// Corners of step `i`.
-    fn corners_of(&self, i: usize) -> Range<usize> {
+    pub(crate) fn corners_of(&self, i: usize) -> Range<usize> {
         self.corner_start[i] as usize..self.corner_start[i + 1] as usize
     }
 
