@@ -71,6 +71,24 @@ pub trait LodSource {
     fn triangles(&self) -> Vec<[u32; 3]>;
 }
 
+/// The finest LoD of `source` with at most `budget` triangles
+/// (`max_lod()` when even the coarsest has more): a binary search over
+/// [`LodSource::triangle_count`], which does not increase with the LoD.
+/// O(log LoDs × the source's count cost).
+#[must_use]
+pub fn lod_for_triangles(source: &dyn LodSource, budget: usize) -> usize {
+    let (mut lo, mut hi) = (0, source.max_lod());
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if source.triangle_count(mid) <= budget {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    lo
+}
+
 impl LodSource for Extractor<'_> {
     fn name(&self) -> &'static str {
         "mts"
