@@ -256,11 +256,13 @@ impl ProgressiveMesh {
 
     /// The compact file: header, positions in level order, the base mesh,
     /// then one record per split in refinement order: the kept vertex
-    /// (`width_for(r)` bits, `r` the new vertex), the new faces (Elias-gamma
-    /// count; per face its third vertex and 3 bits placing `r` and the kept
-    /// vertex) and the redirected corners (gamma count, each a list position
-    /// of `width_for(3 × triangles)` bits). Input numbering is not stored:
-    /// a loaded mesh numbers vertices in level order. O(size).
+    /// (`width_for(r)` bits, `r` the new vertex), the update bit list (one
+    /// bit per triangle holding the kept vertex, in list order: whether its
+    /// corner moves to `r`, as the cluster-tree stream does), and the new
+    /// faces (Elias-gamma count; per face its third vertex and 3 bits
+    /// placing `r` and the kept vertex, so rotations survive). Input
+    /// numbering is not stored: a loaded mesh numbers vertices in level
+    /// order. O(size + T).
     #[must_use]
     pub fn to_bytes(&self) -> Vec<u8> {
         let n = self.positions.len();
@@ -280,44 +282,52 @@ impl ProgressiveMesh {
         let base = self.alive[max_lod] as usize;
         let roots = (n - max_lod) as u64;
         w.put(base as u64, 32);
-        for f in &self.faces[..base] {
+        let mut holders: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for (j, f) in self.faces[..base].iter().enumerate() {
             for &v in f {
                 w.put(u64::from(v), width_for(roots));
+                holders[v as usize].push(j as u32);
             }
         }
-        let corner_width = width_for(3 * self.faces.len() as u64);
+        let mut mark = vec![u32::MAX; self.faces.len()];
         for i in (0..max_lod).rev() {
             let r = (n - 1 - i) as u32;
             let k = self.kept[i];
             w.put(u64::from(k), width_for(u64::from(r)));
+            for c in self.corners_of(i) {
+                mark[self.corners[c] as usize / 3] = i as u32;
+            }
+            for j in std::mem::take(&mut holders[k as usize]) {
+                let moves = mark[j as usize] == i as u32;
+                w.bit(moves);
+                holders[if moves { r } else { k } as usize].push(j);
+            }
             let (after, before) = (self.alive[i + 1] as usize, self.alive[i] as usize);
             w.gamma((before - after) as u64);
-            for f in &self.faces[after..before] {
+            for (j, f) in self.faces.iter().enumerate().take(before).skip(after) {
                 let at = f.iter().position(|&v| v == r).unwrap_or(0);
                 let k_next = f[(at + 1) % 3] == k;
                 let third = f[if k_next { (at + 2) % 3 } else { (at + 1) % 3 }];
-                w.put(u64::from(third), width_for(u64::from(r) + 1));
+                w.put(u64::from(third), width_for(u64::from(r)));
                 w.put(at as u64, 2);
                 w.bit(k_next);
-            }
-            let corners = self.corners_of(i);
-            w.gamma(corners.len() as u64);
-            for c in corners {
-                w.put(u64::from(self.corners[c]), corner_width);
+                for v in [r, k, third] {
+                    holders[v as usize].push(j as u32);
+                }
             }
         }
         w.finish()
     }
 
     /// Parses [`ProgressiveMesh::to_bytes`]'s format, replaying every split
-    /// to check it; `file` names the input in errors. Allocation is bounded
-    /// by what the input's length can hold. O(size + T).
+    /// to rebuild its corner list; `file` names the input in errors.
+    /// Allocation is bounded by what the input's length can hold.
+    /// O(size + T).
     ///
     /// # Errors
     /// [`Error::Parse`] with the byte offset and record for a wrong magic,
-    /// truncated input, an index out of range, a face without its split
-    /// vertices, a corner that does not hold the kept vertex, counts that
-    /// disagree, trailing bytes.
+    /// truncated input, an index out of range, a degenerate face, counts
+    /// that disagree, trailing bytes.
     pub fn from_bytes(bytes: &[u8], file: &str) -> Result<ProgressiveMesh> {
         let mut r = BitReader::new(bytes, file);
         for &b in MAGIC {
@@ -331,9 +341,9 @@ impl ProgressiveMesh {
         if max_lod >= n.max(1) {
             return Err(r.error("split count", format!("{max_lod} splits for {n} vertices")));
         }
-        // Each vertex costs 96 bits, each split at least 3 (two gamma codes
-        // and its kept vertex), each triangle 3 index bits or more.
-        if (n as u64) * 96 + (max_lod as u64) * 2 > r.remaining() || t as u64 > r.remaining() {
+        // Each vertex costs 96 bits, each split at least 1 (its face
+        // count), each triangle 3 bits or more.
+        if (n as u64) * 96 + max_lod as u64 > r.remaining() || 3 * t as u64 > r.remaining() {
             return Err(r.error("header", "counts exceed what the file can hold"));
         }
         let mut positions = Vec::with_capacity(n);
@@ -351,7 +361,8 @@ impl ProgressiveMesh {
             return Err(r.error("base triangle count", format!("{base} exceeds {t}")));
         }
         let mut faces: Vec<[u32; 3]> = Vec::with_capacity(t);
-        for _ in 0..base {
+        let mut holders: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for j in 0..base {
             let f = [
                 r.below(roots, "base triangle")? as u32,
                 r.below(roots, "base triangle")? as u32,
@@ -360,29 +371,45 @@ impl ProgressiveMesh {
             if is_degenerate(f) {
                 return Err(r.error("base triangle", format!("degenerate {f:?}")));
             }
+            for v in f {
+                holders[v as usize].push(j as u32);
+            }
             faces.push(f);
         }
-        // Replay coarse to fine on the list to check every corner.
+        // Replay coarse to fine on the list: the moved corners of each split.
         let mut list: Vec<u32> = faces.iter().flatten().copied().collect();
         let mut kept = vec![0u32; max_lod];
         let mut alive = vec![0u32; max_lod + 1];
         alive[max_lod] = base as u32;
         let mut corner_lists: Vec<(usize, usize)> = vec![(0, 0); max_lod];
         let mut corners_rev: Vec<u32> = Vec::new();
-        let corner_width = width_for(3 * t as u64);
         for i in (0..max_lod).rev() {
             let v = (n - 1 - i) as u32;
             let k = r.below(u64::from(v), "split kept vertex")? as u32;
             kept[i] = k;
+            let start = corners_rev.len();
+            let candidates = std::mem::take(&mut holders[k as usize]);
+            for j in candidates {
+                if r.bit("split update list")? {
+                    let at = 3 * j as usize;
+                    let c = list[at..at + 3].iter().position(|&x| x == k).unwrap_or(0);
+                    list[at + c] = v;
+                    corners_rev.push((at + c) as u32);
+                    holders[v as usize].push(j);
+                } else {
+                    holders[k as usize].push(j);
+                }
+            }
+            corner_lists[i] = (start, corners_rev.len());
             let face_count = r.gamma("split face count")? as usize;
             if faces.len() + face_count > t {
                 return Err(r.error("split face count", format!("more than the {t} triangles")));
             }
             for _ in 0..face_count {
-                let third = r.below(u64::from(v) + 1, "split face")? as u32;
+                let third = r.below(u64::from(v), "split face")? as u32;
                 let at = r.get(2, "split face")? as usize;
                 let k_next = r.bit("split face")?;
-                if at > 2 || third == v || third == k {
+                if at > 2 || third == k {
                     return Err(
                         r.error("split face", format!("bad face: third {third}, slot {at}"))
                     );
@@ -391,31 +418,13 @@ impl ProgressiveMesh {
                 f[at] = v;
                 f[(at + 1) % 3] = if k_next { k } else { third };
                 f[(at + 2) % 3] = if k_next { third } else { k };
-                faces.push(f);
-            }
-            let count = r.gamma("split corner count")? as usize;
-            if count as u64 > r.remaining() / u64::from(corner_width.max(1)) {
-                return Err(r.error("split corner count", "exceeds what the file can hold"));
-            }
-            let start = corners_rev.len();
-            let before = list.len();
-            for _ in 0..count {
-                let p = r.below(3 * t as u64, "split corner")? as usize;
-                if p >= before || list[p] != k {
-                    return Err(r.error(
-                        "split corner",
-                        format!("position {p} does not hold the kept vertex {k}"),
-                    ));
+                let j = faces.len() as u32;
+                for x in [v, k, third] {
+                    holders[x as usize].push(j);
                 }
-                list[p] = v;
-                corners_rev.push(p as u32);
+                faces.push(f);
+                list.extend_from_slice(&f);
             }
-            if corners_rev[start..].windows(2).any(|w| w[0] >= w[1]) {
-                return Err(r.error("split corner", "corners not ascending"));
-            }
-            corner_lists[i] = (start, corners_rev.len());
-            let new = &faces[faces.len() - face_count..];
-            list.extend(new.iter().flatten());
             alive[i] = faces.len() as u32;
         }
         r.finish("end")?;
@@ -424,12 +433,6 @@ impl ProgressiveMesh {
                 "end",
                 format!("{} triangles decoded, header says {t}", faces.len()),
             ));
-        }
-        if list
-            .chunks_exact(3)
-            .any(|c| is_degenerate([c[0], c[1], c[2]]))
-        {
-            return Err(r.error("end", "a degenerate triangle at LoD 0"));
         }
         let mut corner_start = Vec::with_capacity(max_lod + 1);
         let mut corners = Vec::with_capacity(corners_rev.len());
