@@ -511,3 +511,55 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn cluster_view_dependent_cut_is_finer_near_the_eye() {
+    let mesh = torus();
+    let tree = ClusterTree::new(&mesh).unwrap();
+    let order = tree.stream_order();
+    let back = |tris: &[[u32; 3]]| -> Vec<[u32; 3]> {
+        tris.iter().map(|t| t.map(|v| order[v as usize])).collect()
+    };
+    let eye = glam::Vec3::new(3.0, 0.0, 0.0);
+    // Threshold 0 unfolds everything; an infinite one nothing.
+    assert_eq!(
+        sorted_canonical(&back(&tree.view_dependent(eye, 0.0))),
+        sorted_canonical(&mesh.triangles)
+    );
+    assert!(tree.view_dependent(eye, f32::INFINITY).is_empty());
+    let (lo, hi) = mesh.bounds().unwrap();
+    let mut last = usize::MAX;
+    for threshold in [0.001, 0.01, 0.03, 0.1, 0.3] {
+        let tris = tree.view_dependent(eye, threshold);
+        // Nested cuts: fewer triangles as the threshold grows.
+        assert!(
+            tris.len() <= last,
+            "{threshold}: {} after {last}",
+            tris.len()
+        );
+        last = tris.len();
+        let m = Mesh {
+            positions: tree.positions().to_vec(),
+            triangles: tris.clone(),
+        };
+        assert!(tris.iter().all(|&t| !mts::mesh::is_degenerate(t)));
+        assert!(tris
+            .iter()
+            .flatten()
+            .all(|&v| (v as usize) < m.positions.len()));
+        // The half of the torus facing the eye keeps more triangles.
+        let mid = (lo.x + hi.x) / 2.0;
+        let near = tris
+            .iter()
+            .filter(|t| t.iter().all(|&v| m.positions[v as usize].x > mid))
+            .count();
+        let far = tris
+            .iter()
+            .filter(|t| t.iter().all(|&v| m.positions[v as usize].x < mid))
+            .count();
+        // 0.03 and 0.1 cut the torus: its far half loses more.
+        if threshold == 0.03 || threshold == 0.1 {
+            assert!(near > 2 * far, "{threshold}: near {near}, far {far}");
+        }
+    }
+}

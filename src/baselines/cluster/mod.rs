@@ -18,8 +18,10 @@
 //! LoD numbering: LoD `k` is the mesh after the first `k` joins (LoD 0 the
 //! input); its own sequence, so LoD `k` of the cluster tree and of MTS
 //! differ. Budgets ([`ClusterTree::lod_for_size`] or a triangle count)
-//! compare them. Variable resolution by projected cluster size (section 7)
-//! is not implemented.
+//! compare them. Variable resolution by projected cluster size (section 7,
+//! "Variable resolution within one object") is [`ClusterTree::view_dependent`]:
+//! a cut of the tree chosen per node, drawn through its own pc-rep array,
+//! outside the shared LoD numbering.
 
 mod build;
 pub mod stream;
@@ -41,6 +43,12 @@ pub struct ClusterTree {
     /// The joins as a contraction sequence (errors: size / diagonal).
     collapses: Collapses,
     runtime: ProgressiveMesh,
+    /// Input triangles in level numbering (the view-dependent cut reads
+    /// them through its own representatives).
+    triangles: Vec<[u32; 3]>,
+    /// For each join, the later join that folds the cluster it made into
+    /// a larger one (`u32::MAX` for the root's).
+    parent_join: Vec<u32>,
 }
 
 impl ClusterTree {
@@ -71,10 +79,23 @@ impl ClusterTree {
         let collapses = Collapses::new(mesh.vertex_count(), steps, counts, Vec::new());
         let levels = Levels::new(mesh, &collapses)?;
         let runtime = ProgressiveMesh::from_levels(mesh, &levels);
+        // The cluster join `i` makes is represented by its kept vertex; the
+        // next join that involves that vertex folds it further.
+        let n = mesh.vertex_count();
+        let mut last_seen = vec![u32::MAX; n];
+        let mut parent_join = vec![u32::MAX; runtime.kept.len()];
+        for i in (0..runtime.kept.len()).rev() {
+            let (k, r) = (runtime.kept[i] as usize, n - 1 - i);
+            parent_join[i] = last_seen[k];
+            last_seen[k] = i as u32;
+            last_seen[r] = i as u32;
+        }
         Ok(ClusterTree {
             sizes,
             collapses,
             runtime,
+            triangles: levels.triangles,
+            parent_join,
         })
     }
 
@@ -103,6 +124,40 @@ impl ClusterTree {
     #[must_use]
     pub fn to_stream(&self) -> Vec<u8> {
         stream::encode(&self.runtime)
+    }
+
+    /// Variable resolution (section 7): the triangles of the cut where a
+    /// node is unfolded when its projected size, cluster size over the
+    /// distance from `eye` to its representative, is at least `threshold`
+    /// (radians, roughly) and the node above it is unfolded too. Indices
+    /// refer to [`LodSource::positions`]; nearer parts come out finer.
+    /// `threshold = 0` gives the full mesh. O(V + T); allocates the result
+    /// and two working arrays.
+    #[must_use]
+    pub fn view_dependent(&self, eye: Vec3, threshold: f32) -> Vec<[u32; 3]> {
+        let kept = &self.runtime.kept;
+        let positions = &self.runtime.positions;
+        let n = positions.len();
+        let mut unfolded = vec![false; kept.len()];
+        for i in (0..kept.len()).rev() {
+            let above = self.parent_join[i];
+            let open = above == u32::MAX || unfolded[above as usize];
+            let distance = positions[kept[i] as usize].distance(eye);
+            unfolded[i] = open && self.sizes[i] >= threshold * distance;
+        }
+        let roots = n - kept.len();
+        let mut pc: Vec<u32> = (0..n as u32).collect();
+        for v in roots..n {
+            let i = n - 1 - v;
+            if !unfolded[i] {
+                pc[v] = pc[kept[i] as usize];
+            }
+        }
+        self.triangles
+            .iter()
+            .map(|t| t.map(|v| pc[v as usize]))
+            .filter(|&t| !crate::mesh::is_degenerate(t))
+            .collect()
     }
 
     /// Input vertex of each stream vertex (the stream numbers vertices in
