@@ -4,7 +4,7 @@
 //! "Vertex representatives", "Progressive multilevel mesh", "Low memory
 //! footprint" and "Geomorphs".
 //!
-//! Vertices and triangles are sorted by level ([`super::levels`]: one level
+//! Vertices and triangles are sorted by level (`baselines/levels.rs`: one level
 //! per contraction, so the paper's level `l` is our LoD `l`), each removed
 //! vertex stores one representative (an older vertex), and LoD `k` uses
 //! vertices `0..n_k` (`n_k = n - k`) and the triangles of level `>= k`, a

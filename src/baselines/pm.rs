@@ -4,7 +4,7 @@
 //! MTS model.
 //!
 //! The base mesh is LoD `max_lod`; split `i` undoes contraction `i`. With
-//! vertices and triangles in level order ([`super::levels`]) the triangle
+//! vertices and triangles in level order (`baselines/levels.rs`) the triangle
 //! list of every LoD is a prefix of one maintained `u32` list: split `i`
 //! appends the faces contraction `i` removed (they occupy list positions
 //! `alive(i + 1)..alive(i)`) and moves the corners that contraction `i`
@@ -69,7 +69,7 @@ impl ProgressiveMesh {
     /// sequence.
     ///
     /// # Errors
-    /// [`Error::InvalidArgument`] when `collapses` uses optimal placement or
+    /// [`crate::Error::InvalidArgument`] when `collapses` uses optimal placement or
     /// belongs to another mesh.
     pub fn new(mesh: &Mesh, collapses: &Collapses) -> Result<ProgressiveMesh> {
         let levels = Levels::new(mesh, collapses)?;
@@ -325,7 +325,7 @@ impl ProgressiveMesh {
     /// O(size + T).
     ///
     /// # Errors
-    /// [`Error::Parse`] with the byte offset and record for a wrong magic,
+    /// [`crate::Error::Parse`] with the byte offset and record for a wrong magic,
     /// truncated input, an index out of range, a degenerate face, counts
     /// that disagree, trailing bytes.
     pub fn from_bytes(bytes: &[u8], file: &str) -> Result<ProgressiveMesh> {

@@ -2,7 +2,7 @@
 //! ("Transmission protocol") of the cluster-tree paper, and its incremental
 //! decoder (section 7, "Model reconstruction").
 //!
-//! Layout (bits packed least significant first, see [`super::super::bits`]):
+//! Layout (bits packed least significant first, see `baselines/bits.rs`):
 //!
 //! ```text
 //! header   magic "MTSCT\0\0\x01", vertices, triangles, roots, base
