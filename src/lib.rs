@@ -4,7 +4,10 @@
 //! into generalized triangle strips ([`stripify`], a STRIPE-style hybrid
 //! search), and measured against meshoptimizer ([`peers::meshopt`]). Later
 //! stages (simplification, the multiresolution model, the renderer) build
-//! on these types; see `ARCHITECTURE.md` and `../shared/DESIGN.md`.
+//! on these types; see `ARCHITECTURE.md` and `../shared/DESIGN.md`. The
+//! methods MTS is measured against ([`baselines`]: progressive mesh,
+//! progressive multilevel mesh, cluster tree with its packet stream,
+//! discrete LoDs) and MTS itself share one interface, [`LodSource`].
 //!
 //! ```
 //! use mts::mesh::generate::Generated;
