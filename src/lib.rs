@@ -2,11 +2,15 @@
 //!
 //! A mesh is loaded ([`mesh::io`]) or generated ([`mesh::generate`]), cut
 //! into generalized triangle strips ([`stripify`], a STRIPE-style hybrid
-//! search), and measured against meshoptimizer ([`peers::meshopt`]). Later
-//! stages (simplification, the multiresolution model, the renderer) build
-//! on these types; see `ARCHITECTURE.md` and `../shared/DESIGN.md`. The
-//! wgpu renderer (`render`, feature `render`, on by default) draws an
-//! [`Extractor`]'s output and uploads only the ranges a LoD change rewrote.
+//! search) and simplified into one contraction sequence ([`simplify`]);
+//! from both, [`model::build`] makes the multiresolution model
+//! ([`MtsModel`]) whose [`Extractor`] emits strips for any LoD, re-walking
+//! only the strips that changed. See `ARCHITECTURE.md` and
+//! `../shared/DESIGN.md`. The wgpu renderer (`render`, feature `render`, on
+//! by default) draws an [`Extractor`]'s output and uploads only the ranges
+//! a LoD change rewrote. The methods MTS is measured against ([`baselines`]: progressive mesh,
+//! progressive multilevel mesh, cluster tree with its packet stream,
+//! discrete LoDs) and MTS itself share one interface, [`LodSource`].
 //!
 //! ```
 //! use mts::mesh::generate::Generated;
@@ -24,8 +28,10 @@
 //! # Ok::<(), mts::Error>(())
 //! ```
 
+pub mod baselines;
 pub mod distance;
 pub mod error;
+pub mod lod;
 pub mod mesh;
 pub mod model;
 pub mod peers;
@@ -35,6 +41,7 @@ pub mod simplify;
 pub mod strip;
 
 pub use error::{Error, Place, Result};
+pub use lod::{LodSource, Topology};
 pub use mesh::Mesh;
 pub use model::{Extractor, MtsModel};
 pub use simplify::{simplify, Collapses, SimplifyOptions};

@@ -107,3 +107,70 @@ fn verify_takes_a_mesh_and_spread_lods() {
     assert!(!ok);
     assert!(err.contains("--lods"), "{err}");
 }
+
+#[test]
+fn encode_decode_and_extract_with_every_method() {
+    let dir = std::env::temp_dir().join(format!("mts-cli-stream-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("torus.stream");
+    let file = file.to_str().unwrap();
+    let (ok, out, err) = mts(&["encode", "--generated", "torus:2k", "-o", file, "--json"]);
+    assert!(ok, "{err}");
+    let e = json(&out);
+    assert_eq!(e["vertices"].as_u64(), Some(968));
+    assert_eq!(e["triangles"].as_u64(), Some(1936));
+    assert_eq!(e["raw_bytes_u16"].as_u64(), Some(12 * 968 + 6 * 1936));
+    let bytes = e["bytes"].as_u64().unwrap();
+    assert_eq!(bytes, std::fs::metadata(file).unwrap().len());
+    assert!(bytes < 12 * 968 + 6 * 1936);
+
+    let (ok, out, err) = mts(&["decode", file, "--json"]);
+    assert!(ok, "{err}");
+    let d = json(&out);
+    assert_eq!(d["vertices"].as_u64(), Some(968));
+    assert_eq!(d["triangles"].as_u64(), Some(1936));
+    assert_eq!(d["complete"].as_bool(), Some(true));
+    assert_eq!(d["bytes_used"].as_u64(), Some(bytes));
+
+    let (ok, out, err) = mts(&["decode", file, "--bytes", "4000", "--json"]);
+    assert!(ok, "{err}");
+    let p = json(&out);
+    assert_eq!(p["complete"].as_bool(), Some(false));
+    assert!(p["bytes_used"].as_u64().unwrap() <= 4000);
+    let partial = p["triangles"].as_u64().unwrap();
+    assert!(partial > 0 && partial < 1936, "{partial}");
+
+    // A truncated stream without --bytes is an error naming the file.
+    let cut = dir.join("cut.stream");
+    let all = std::fs::read(file).unwrap();
+    std::fs::write(&cut, &all[..all.len() / 2]).unwrap();
+    let (ok, _, err) = mts(&["decode", cut.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("cut.stream"), "{err}");
+
+    for method in ["mts", "pm", "multilevel", "cluster", "discrete"] {
+        let (ok, out, err) = mts(&[
+            "extract",
+            "--generated",
+            "torus:2k",
+            "--method",
+            method,
+            "--ratio",
+            "0.5",
+            "--repeat",
+            "1",
+            "--json",
+        ]);
+        assert!(ok, "{method}: {err}");
+        let x = json(&out);
+        let triangles = x["triangles"].as_u64().unwrap();
+        // At most half of the 1936 triangles, except discrete LoDs, which
+        // answer with the coarsest level at or above the budget.
+        if method == "discrete" {
+            assert!(triangles >= 968, "{method}: {triangles}");
+        } else {
+            assert!(triangles <= 968 && triangles > 900, "{method}: {triangles}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

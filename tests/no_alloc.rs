@@ -1,5 +1,6 @@
-//! `Extractor::set_lod` allocates nothing after construction: counted with
-//! a global allocator wrapper (this test binary only).
+//! `Extractor::set_lod` and the baselines' `LodSource::set_lod` allocate
+//! nothing after construction: counted with a global allocator wrapper (this
+//! test binary only; one test, so no other thread allocates meanwhile).
 
 use mts::mesh::generate::Generated;
 use mts::model::BuildOptions;
@@ -48,4 +49,32 @@ fn set_lod_allocates_nothing() {
         ex.set_ratio(0.5);
     }
     assert_eq!(ALLOCATIONS.load(Ordering::Relaxed) - before, 0);
+
+    // The baselines, over the same sequence.
+    use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
+    use mts::LodSource;
+    let mut sources: Vec<Box<dyn LodSource>> = vec![
+        Box::new(ProgressiveMesh::new(&mesh, &collapses).unwrap()),
+        Box::new(MultilevelMesh::new(&mesh, &collapses).unwrap()),
+        Box::new(ClusterTree::new(&mesh).unwrap()),
+        Box::new(DiscreteLods::new(&mesh, collapses.triangle_counts())),
+    ];
+    for source in &mut sources {
+        source.set_lod(0);
+        let max = source.max_lod();
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for lod in (0..=max)
+            .step_by(7)
+            .chain((0..=max).rev().step_by(13))
+            .chain([max, 0, max / 2, max / 3])
+        {
+            source.set_lod(lod);
+        }
+        assert_eq!(
+            ALLOCATIONS.load(Ordering::Relaxed) - before,
+            0,
+            "{}",
+            source.name()
+        );
+    }
 }

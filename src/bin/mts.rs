@@ -60,6 +60,16 @@ enum Command {
     Info(InfoArgs),
     /// Extract one LoD of a model as restart-encoded strips.
     Extract(ExtractArgs),
+    /// Encode a mesh as the cluster tree's packet stream (a progressive,
+    /// incrementally decodable file).
+    Encode(EncodeArgs),
+    /// Decode a packet stream, or only its first bytes (what a receiver
+    /// draws while the stream arrives).
+    Decode(DecodeArgs),
+    /// Every method side by side on one mesh: bytes, build time and
+    /// microseconds per LoD change on the linear, exponential and random
+    /// request sequences.
+    Compare(CompareArgs),
     /// Check a model against the replay oracle and coherent against
     /// from-scratch extraction; exits non-zero on any mismatch.
     Verify(VerifyArgs),
@@ -608,6 +618,9 @@ fn run(cli: &Cli) -> Result<()> {
             let (name, mesh, _) = args.source.load()?;
             demo::run(&name, &mesh, &args.thumbnails)
         }
+        Command::Encode(args) => encode(args),
+        Command::Decode(args) => decode(args),
+        Command::Compare(args) => compare(args),
         Command::Verify(args) => {
             if verify(args)? {
                 Ok(())
@@ -786,10 +799,60 @@ struct ExtractArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
+    /// The method extracting the LoD: mts (strips) or a baseline. The
+    /// cluster tree has its own clustering, so its LoD k differs; use
+    /// --triangles or --ratio to compare methods.
+    #[arg(long, value_enum, default_value_t = Method::Mts)]
+    method: Method,
+}
+
+/// The LoD methods (`LodSource` implementations).
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Method {
+    /// Multiresolution triangle strips.
+    Mts,
+    /// Progressive mesh (Hoppe 1996).
+    Pm,
+    /// Progressive multilevel mesh.
+    Multilevel,
+    /// Cluster tree.
+    Cluster,
+    /// meshoptimizer simplify at fixed ratios.
+    Discrete,
+}
+
+impl Method {
+    const ALL: [Method; 5] = [
+        Method::Mts,
+        Method::Pm,
+        Method::Multilevel,
+        Method::Cluster,
+        Method::Discrete,
+    ];
+}
+
+/// The source of `method` over `model` (its mesh and contraction sequence).
+fn make_source<'m>(
+    method: Method,
+    model: &'m mts::MtsModel,
+    mesh: &Mesh,
+) -> Result<Box<dyn mts::LodSource + 'm>> {
+    use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
+    let c = model.collapses();
+    Ok(match method {
+        Method::Mts => Box::new(mts::Extractor::new(model)),
+        Method::Pm => Box::new(ProgressiveMesh::new(mesh, c)?),
+        Method::Multilevel => Box::new(MultilevelMesh::new(mesh, c)?),
+        Method::Cluster => Box::new(ClusterTree::new(mesh)?),
+        Method::Discrete => Box::new(DiscreteLods::new(mesh, c.triangle_counts())),
+    })
 }
 
 fn extract(args: &ExtractArgs) -> Result<()> {
     use mts::Extractor;
+    if args.method != Method::Mts {
+        return extract_baseline(args);
+    }
     let (name, model) = args.source.load()?;
     let lod = match (args.lod, args.triangles, args.ratio) {
         (Some(l), _, _) => l.min(model.max_lod()),
@@ -999,4 +1062,270 @@ fn main() -> std::process::ExitCode {
             std::process::ExitCode::FAILURE
         }
     }
+}
+
+fn extract_baseline(args: &ExtractArgs) -> Result<()> {
+    let (name, model) = args.source.load()?;
+    let mesh = model.mesh();
+    let mut source = make_source(args.method, &model, &mesh)?;
+    let lod = match (args.lod, args.triangles, args.ratio) {
+        (Some(l), _, _) => l.min(source.max_lod()),
+        (_, Some(n), _) => mts::lod::lod_for_triangles(source.as_ref(), n),
+        (_, _, Some(r)) => {
+            if !(0.0..=1.0).contains(&r) {
+                bail!("--ratio must be between 0 and 1, not {r}");
+            }
+            let full = source.triangle_count(0) as f64;
+            mts::lod::lod_for_triangles(source.as_ref(), (r * full).round() as usize)
+        }
+        _ => bail!("give --lod, --triangles or --ratio"),
+    };
+    // Each timed change starts from a fresh source (no coherence).
+    let mut times = Vec::with_capacity(args.repeat.max(1));
+    for _ in 0..args.repeat.max(1) {
+        source = make_source(args.method, &model, &mesh)?;
+        let t = Instant::now();
+        source.set_lod(lod);
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    times.sort_by(f64::total_cmp);
+    let us = times[times.len() / 2];
+    let triangles = source.triangles();
+    if let Some(out) = &args.output {
+        let m = Mesh {
+            positions: mesh.positions.clone(),
+            triangles: triangles.clone(),
+        };
+        mts::mesh::io::save_obj(&m, out)?;
+    }
+    let method = source.name();
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "method": method,
+                "lod": lod,
+                "max_lod": source.max_lod(),
+                "triangles": triangles.len(),
+                "indices": source.indices().len(),
+                "indices_per_triangle": source.indices().len() as f64 / triangles.len().max(1) as f64,
+                "us": us,
+            })
+        );
+    } else {
+        println!(
+            "{name}: {method} LoD {lod} of {}: {} triangles, {} indices sent, set in {us:.1} us (median of {} from a fresh source)",
+            source.max_lod(),
+            triangles.len(),
+            source.indices().len(),
+            times.len()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+struct EncodeArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// The stream file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print JSON instead of a sentence.
+    #[arg(long)]
+    json: bool,
+}
+
+fn encode(args: &EncodeArgs) -> Result<()> {
+    let (name, mesh, _) = args.source.load()?;
+    let t = Instant::now();
+    let tree = mts::baselines::ClusterTree::new(&mesh)?;
+    let bytes = tree.to_stream();
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    std::fs::write(&args.output, &bytes)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let raw = 12 * mesh.vertex_count() + 6 * mesh.triangle_count();
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "vertices": mesh.vertex_count(),
+                "triangles": mesh.triangle_count(),
+                "bytes": bytes.len(),
+                "raw_bytes_u16": raw,
+                "ratio": bytes.len() as f64 / raw as f64,
+                "ms": ms,
+            })
+        );
+    } else {
+        println!(
+            "{name}: {} vertices, {} triangles -> {} bytes = {:.1}% of raw ({raw} bytes: 12 per vertex + 6 per triangle), {ms:.0} ms -> {}",
+            mesh.vertex_count(),
+            mesh.triangle_count(),
+            bytes.len(),
+            100.0 * bytes.len() as f64 / raw as f64,
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+struct DecodeArgs {
+    /// The stream file.
+    stream: PathBuf,
+    /// Decode only the first N bytes (the packets they hold completely).
+    #[arg(long)]
+    bytes: Option<usize>,
+    /// Write the decoded mesh as OBJ.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Print JSON instead of a sentence.
+    #[arg(long)]
+    json: bool,
+}
+
+fn decode(args: &DecodeArgs) -> Result<()> {
+    use mts::baselines::cluster::stream;
+    let all = std::fs::read(&args.stream)
+        .with_context(|| format!("cannot read {}", args.stream.display()))?;
+    let file = args.stream.display().to_string();
+    let t = Instant::now();
+    let d = match args.bytes {
+        Some(n) => stream::decode_prefix(&all[..n.min(all.len())], &file)?,
+        None => stream::decode(&all, &file)?,
+    };
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    let mesh = d.mesh();
+    mesh.validate()?;
+    if let Some(out) = &args.output {
+        mts::mesh::io::save_obj(&mesh, out)?;
+    }
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": file,
+                "bytes_read": args.bytes.unwrap_or(all.len()).min(all.len()),
+                "bytes_used": d.bytes_used,
+                "vertices": d.positions.len(),
+                "triangles": d.triangles.len(),
+                "total_vertices": d.total_vertices,
+                "total_triangles": d.total_triangles,
+                "complete": d.is_complete(),
+                "ms": ms,
+            })
+        );
+    } else {
+        println!(
+            "{file}: {} of {} vertices and {} of {} triangles from {} bytes ({}), {ms:.1} ms",
+            d.positions.len(),
+            d.total_vertices,
+            d.triangles.len(),
+            d.total_triangles,
+            d.bytes_used,
+            if d.is_complete() {
+                "complete"
+            } else {
+                "partial"
+            }
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+struct CompareArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// Requests in each sequence (linear, exponential, random).
+    #[arg(long, default_value_t = 100)]
+    requests: usize,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+fn compare(args: &CompareArgs) -> Result<()> {
+    use mts::model::sequence;
+    let (name, mesh, _) = args.source.load()?;
+    let t = Instant::now();
+    let (model, _, _) = build_with_bar(&mesh, &Default::default());
+    let mts_ms = t.elapsed().as_secs_f64() * 1e3;
+    let raw = 12 * mesh.vertex_count() + 6 * mesh.triangle_count();
+    let mut rows = Vec::new();
+    for method in Method::ALL {
+        let t = Instant::now();
+        let mut source = make_source(method, &model, &mesh)?;
+        // The baselines start from the contraction sequence MTS recorded;
+        // its time is MTS's simplify stage, counted in MTS's build.
+        let build_ms =
+            t.elapsed().as_secs_f64() * 1e3 + if method == Method::Mts { mts_ms } else { 0.0 };
+        let max_lod = source.max_lod();
+        let counts: Vec<u32> = (0..=max_lod)
+            .map(|l| source.triangle_count(l) as u32)
+            .collect();
+        let sequences = [
+            ("linear", sequence::linear(max_lod, args.requests)),
+            ("exponential", sequence::exponential(&counts, args.requests)),
+            ("random", sequence::random(max_lod, args.requests, 1)),
+        ];
+        let mut us = serde_json::Map::new();
+        for (label, lods) in &sequences {
+            source.set_lod(max_lod);
+            let t = Instant::now();
+            for &l in lods {
+                source.set_lod(l);
+            }
+            let per = t.elapsed().as_secs_f64() * 1e6 / lods.len().max(1) as f64;
+            us.insert((*label).to_string(), json!(per));
+        }
+        let file = source.file_bytes();
+        rows.push(json!({
+            "method": source.name(),
+            "build_ms": build_ms,
+            "memory_bytes": source.memory_bytes(),
+            "file_bytes": file,
+            "file_ratio_to_raw_u16": file as f64 / raw as f64,
+            "us_per_change": us,
+        }));
+    }
+    let mesh_info = json!({
+        "input": name,
+        "vertices": mesh.vertex_count(),
+        "triangles": mesh.triangle_count(),
+        "raw_bytes_u16": raw,
+        "requests": args.requests,
+    });
+    if args.json {
+        println!("{}", json!({"mesh": mesh_info, "methods": rows}));
+        return Ok(());
+    }
+    println!(
+        "{name}: {} vertices, {} triangles, raw {raw} bytes (12 per vertex + 6 per triangle); {} requests per sequence",
+        mesh.vertex_count(),
+        mesh.triangle_count(),
+        args.requests
+    );
+    println!(
+        "{:<12}{:>10}{:>12}{:>12}{:>8}{:>10}{:>10}{:>10}",
+        "method", "build ms", "memory B", "file B", "/raw", "us lin", "us exp", "us rand"
+    );
+    for r in &rows {
+        let f = |v: &serde_json::Value| v.as_f64().unwrap_or(0.0);
+        println!(
+            "{:<12}{:>10.1}{:>12}{:>12}{:>8.3}{:>10.1}{:>10.1}{:>10.1}",
+            r["method"].as_str().unwrap_or(""),
+            f(&r["build_ms"]),
+            r["memory_bytes"].as_u64().unwrap_or(0),
+            r["file_bytes"].as_u64().unwrap_or(0),
+            f(&r["file_ratio_to_raw_u16"]),
+            f(&r["us_per_change"]["linear"]),
+            f(&r["us_per_change"]["exponential"]),
+            f(&r["us_per_change"]["random"]),
+        );
+    }
+    Ok(())
 }

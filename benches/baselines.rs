@@ -1,0 +1,73 @@
+//! Criterion: microseconds per LoD change of MTS and every baseline on the
+//! MTS paper's Table 2 request sequences (linear, exponential, random; 100
+//! requests each, from each method's own LoD table), one group per
+//! sequence with the methods side by side. The bunny, or a generated 70K
+//! icosphere when `../shared/models` is absent. Throughput is per change.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
+use mts::mesh::generate::Generated;
+use mts::mesh::io::{load, LoadOptions};
+use mts::model::{build_from_mesh, sequence, PipelineOptions};
+use mts::{Extractor, LodSource, Mesh};
+use std::hint::black_box;
+use std::path::Path;
+
+fn input() -> (String, Mesh) {
+    let bunny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models/bunny.ply");
+    match load(&bunny, LoadOptions::default()) {
+        Ok((mesh, _)) => ("bunny".into(), mesh),
+        Err(e) => {
+            eprintln!("the bunny is missing ({e}); using icosphere:70k");
+            let g: Generated = "icosphere:70k".parse().expect("valid name");
+            ("icosphere:70k".into(), g.build())
+        }
+    }
+}
+
+const REQUESTS: usize = 100;
+
+fn bench(c: &mut Criterion) {
+    let (name, mesh) = input();
+    let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
+    let collapses = model.collapses();
+    let mut sources: Vec<Box<dyn LodSource + '_>> = vec![
+        Box::new(Extractor::new(&model)),
+        Box::new(ProgressiveMesh::new(&mesh, collapses).expect("endpoint sequence")),
+        Box::new(MultilevelMesh::new(&mesh, collapses).expect("endpoint sequence")),
+        Box::new(ClusterTree::new(&mesh).expect("a mesh with vertices")),
+        Box::new(DiscreteLods::new(&mesh, collapses.triangle_counts())),
+    ];
+    for seq in ["linear", "exponential", "random"] {
+        let mut group = c.benchmark_group(format!("lod_change/{name}/{seq}"));
+        // Short: the machine is shared (warm-up 1 s, 2 s per method).
+        group.sample_size(10);
+        group.warm_up_time(std::time::Duration::from_secs(1));
+        group.measurement_time(std::time::Duration::from_secs(2));
+        group.throughput(Throughput::Elements(REQUESTS as u64));
+        for source in &mut sources {
+            let max_lod = source.max_lod();
+            let lods = match seq {
+                "linear" => sequence::linear(max_lod, REQUESTS),
+                "exponential" => {
+                    let counts: Vec<u32> = (0..=max_lod)
+                        .map(|l| source.triangle_count(l) as u32)
+                        .collect();
+                    sequence::exponential(&counts, REQUESTS)
+                }
+                _ => sequence::random(max_lod, REQUESTS, 1),
+            };
+            group.bench_function(source.name(), |b| {
+                b.iter(|| {
+                    for &lod in &lods {
+                        source.set_lod(black_box(lod));
+                    }
+                });
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
