@@ -1248,17 +1248,23 @@ struct CompareArgs {
     json: bool,
 }
 
-fn compare(args: &CompareArgs) -> Result<()> {
+/// Every method (MTS and the baselines) over the same mesh and contraction
+/// sequence, measured in one run: build milliseconds (MTS: `mts_ms`, the
+/// whole pipeline; the baselines: their own construction from the mesh and
+/// MTS's sequence), bytes in memory and on disk, and microseconds per LoD
+/// change over the Table 2 sequences of `requests` requests each.
+fn measure_methods(
+    model: &mts::MtsModel,
+    mesh: &Mesh,
+    mts_ms: f64,
+    requests: usize,
+) -> Result<Vec<serde_json::Value>> {
     use mts::model::sequence;
-    let (name, mesh, _) = args.source.load()?;
-    let t = Instant::now();
-    let (model, _, _) = build_with_bar(&mesh, &Default::default());
-    let mts_ms = t.elapsed().as_secs_f64() * 1e3;
     let raw = 12 * mesh.vertex_count() + 6 * mesh.triangle_count();
     let mut rows = Vec::new();
     for method in Method::ALL {
         let t = Instant::now();
-        let mut source = make_source(method, &model, &mesh)?;
+        let mut source = make_source(method, model, mesh)?;
         // The baselines start from the contraction sequence MTS recorded;
         // its time is MTS's simplify stage, counted in MTS's build.
         let build_ms =
@@ -1268,9 +1274,9 @@ fn compare(args: &CompareArgs) -> Result<()> {
             .map(|l| source.triangle_count(l) as u32)
             .collect();
         let sequences = [
-            ("linear", sequence::linear(max_lod, args.requests)),
-            ("exponential", sequence::exponential(&counts, args.requests)),
-            ("random", sequence::random(max_lod, args.requests, 1)),
+            ("linear", sequence::linear(max_lod, requests)),
+            ("exponential", sequence::exponential(&counts, requests)),
+            ("random", sequence::random(max_lod, requests, 1)),
         ];
         let mut us = serde_json::Map::new();
         for (label, lods) in &sequences {
@@ -1292,6 +1298,16 @@ fn compare(args: &CompareArgs) -> Result<()> {
             "us_per_change": us,
         }));
     }
+    Ok(rows)
+}
+
+fn compare(args: &CompareArgs) -> Result<()> {
+    let (name, mesh, _) = args.source.load()?;
+    let t = Instant::now();
+    let (model, _, _) = build_with_bar(&mesh, &Default::default());
+    let mts_ms = t.elapsed().as_secs_f64() * 1e3;
+    let raw = 12 * mesh.vertex_count() + 6 * mesh.triangle_count();
+    let rows = measure_methods(&model, &mesh, mts_ms, args.requests)?;
     let mesh_info = json!({
         "input": name,
         "vertices": mesh.vertex_count(),

@@ -118,8 +118,57 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
         "machine": machine(&renderer),
         "models": models,
         "scale": scale,
-        "fast_simplification": Value::Null,
+        "fast_simplification": if options.quick {
+            Value::Null
+        } else {
+            progress("fast-simplification");
+            fast_simplification(&options.models)
+        },
     }))
+}
+
+/// The fast-simplification peer (`benches/peers/fast_simplification.py`)
+/// at 10% and 1% of every model, its error measured by this binary's `mts
+/// distance`: one row per model and share, or `{"skipped": why}` when
+/// Python or the package is missing (`pip install fast-simplification
+/// numpy`).
+fn fast_simplification(models: &[PathBuf]) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/peers/fast_simplification.py");
+    let Ok(exe) = std::env::current_exe() else {
+        return json!({"skipped": "cannot find this binary for `mts distance`"});
+    };
+    if models.is_empty() {
+        return json!({"skipped": "no model files"});
+    }
+    let out = std::process::Command::new("python3")
+        .arg(&script)
+        .args(["--ratios", "0.1,0.01", "--repeat", "1", "--mts"])
+        .arg(&exe)
+        .args(models)
+        .output();
+    match out {
+        Err(e) => json!({"skipped": format!("python3: {e}")}),
+        Ok(o) if !o.status.success() => json!({
+            "skipped": String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or("failed").to_string()
+        }),
+        Ok(o) => Value::Array(
+            String::from_utf8_lossy(&o.stdout)
+                .lines()
+                .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+                .map(|mut v| {
+                    // The file name, as the models' rows name them.
+                    if let Some(name) = v["mesh"]
+                        .as_str()
+                        .and_then(|m| Path::new(m).file_name())
+                        .map(|n| n.to_string_lossy().into_owned())
+                    {
+                        v["mesh"] = Value::from(name);
+                    }
+                    v
+                })
+                .collect(),
+        ),
+    }
 }
 
 /// CPU, cores and system of this machine, and the graphics adapter of
@@ -211,6 +260,7 @@ fn measure_model(
         "extraction": measure_sequences(&model, requests),
         "levels": measure_levels(&model),
         "quality": measure_quality(mesh, &model),
+        "methods": super::measure_methods(&model, mesh, ms(t.total), requests)?,
         "figure6": match renderer {
             #[cfg(feature = "render")]
             Ok(r) => r.measure(&model, shares, frames)?,
@@ -464,6 +514,24 @@ pub fn report(results: &Value) -> String {
             f(&t["total"]),
         );
     }
+    let _ = writeln!(s, "\n### Table 1, every method: bytes and build time\n");
+    let _ = writeln!(s, "File bytes against the raw mesh with 16-bit indices (12 per vertex + 6 per triangle, the cluster-tree paper's reference). MTS builds the whole pipeline; the baselines start from the mesh and MTS's contraction sequence (the cluster tree makes its own clustering). Multilevel has no file format of its own: its figure is the in-memory structure.\n");
+    let _ = writeln!(s, "| model | method | file bytes | file / raw 16-bit | memory bytes | build ms |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    for r in &models {
+        for m in r["methods"].as_array().into_iter().flatten() {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.3} | {} | {:.0} |",
+                r["name"].as_str().unwrap_or("?"),
+                m["method"].as_str().unwrap_or("?"),
+                m["file_bytes"],
+                f(&m["file_ratio_to_raw_u16"]),
+                m["memory_bytes"],
+                f(&m["build_ms"]),
+            );
+        }
+    }
     let _ = writeln!(s, "\n## Table 2: microseconds per LoD change\n");
     let _ = writeln!(s, "Sequences of `mts::model::sequence` (linear: coarsest to finest in equal steps; exponential: triangle counts in geometric steps; random: uniform, seed 1); medians of three passes.\n");
     let _ = writeln!(s, "| model | linear coherent | linear without | × | exponential coherent | exponential without | × | random coherent | random without | × |");
@@ -476,6 +544,24 @@ pub fn report(results: &Value) -> String {
             let _ = write!(row, " {c:.1} | {w:.1} | {:.1} |", w / c);
         }
         let _ = writeln!(s, "{row}");
+    }
+    let _ = writeln!(s, "\n### Table 2, every method: microseconds per LoD change\n");
+    let _ = writeln!(s, "Each method through `LodSource::set_lod` (MTS: the coherent extractor), the same sequences over its own LoD range, in one run. The cluster tree's LoDs are its own joins; discrete LoDs only switch buffers.\n");
+    let _ = writeln!(s, "| model | method | linear | exponential | random |");
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for r in &models {
+        for m in r["methods"].as_array().into_iter().flatten() {
+            let u = &m["us_per_change"];
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.1} | {:.1} | {:.1} |",
+                r["name"].as_str().unwrap_or("?"),
+                m["method"].as_str().unwrap_or("?"),
+                f(&u["linear"]),
+                f(&u["exponential"]),
+                f(&u["random"]),
+            );
+        }
     }
     let _ = writeln!(
         s,
@@ -512,13 +598,32 @@ pub fn report(results: &Value) -> String {
         "\n\n## Quality: simplification error against meshoptimizer\n"
     );
     let _ = writeln!(s, "Hausdorff and RMS distance to the input relative to its bounding-box diagonal ({SAMPLES} samples per side), meshoptimizer's `simplify` asked for the same triangle count.\n");
-    let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts | Hausdorff meshopt | ratio | RMS mts | RMS meshopt |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    let peer = results["fast_simplification"].as_array();
+    if let Some(why) = results["fast_simplification"]["skipped"].as_str() {
+        let _ = writeln!(s, "fast-simplification not measured: {why}.\n");
+    }
+    let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts | Hausdorff meshopt | ratio | RMS mts | RMS meshopt | fast-simplification triangles, Hausdorff, RMS |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
     for r in &models {
         for q in r["quality"].as_array().into_iter().flatten() {
+            let fast = peer
+                .into_iter()
+                .flatten()
+                .find(|p| p["mesh"] == r["name"] && p["ratio"].as_f64() == q["share"].as_f64())
+                .map_or_else(
+                    || "—".to_string(),
+                    |p| {
+                        format!(
+                            "{}, {:.5}, {:.5}",
+                            p["triangles"],
+                            f(&p["hausdorff"]),
+                            f(&p["rms"])
+                        )
+                    },
+                );
             let _ = writeln!(
                 s,
-                "| {} | {:.0}% | {} / {} | {:.5} | {:.5} | {:.2} | {:.5} | {:.5} |",
+                "| {} | {:.0}% | {} / {} | {:.5} | {:.5} | {:.2} | {:.5} | {:.5} | {fast} |",
                 r["name"].as_str().unwrap_or("?"),
                 f(&q["share"]) * 100.0,
                 q["mts"]["triangles"],
