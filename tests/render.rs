@@ -279,6 +279,51 @@ fn dirty_range_updates_equal_full_uploads() {
 }
 
 #[test]
+fn baselines_through_upload_source_cover_what_the_oracle_covers() {
+    use mts::baselines::{MultilevelMesh, ProgressiveMesh};
+    use mts::LodSource;
+    let Some(gpu) = gpu() else { return };
+    let mesh: Mesh = "torus:8k".parse::<Generated>().unwrap().build();
+    let model = model_of(&mesh);
+    let mut scene = Scene::new(&gpu, &model);
+    scene.camera.shading = Shading::Unlit;
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let mut oracle = scene.renderer(&model, StripMode::Restart);
+    let config = RendererConfig {
+        color_format: COLOR_FORMAT,
+        depth_format: Some(DEPTH_FORMAT),
+        strip_mode: StripMode::Restart,
+    };
+    let sources: Vec<Box<dyn LodSource>> = vec![
+        Box::new(ProgressiveMesh::new(&mesh, model.collapses()).unwrap()),
+        Box::new(MultilevelMesh::new(&mesh, model.collapses()).unwrap()),
+    ];
+    for mut source in sources {
+        // The baseline's own vertex numbering: its own renderer.
+        let mut renderer = StripRenderer::new(d, q, &config, source.positions(), &[]).unwrap();
+        for ratio in [1.0, 0.3, 0.05] {
+            let lod = model.lod_for_ratio(ratio);
+            source.set_lod(lod);
+            renderer.upload_source(d, q, &*source).unwrap();
+            let triangles = model.collapses().triangles_at(&mesh, lod);
+            oracle.upload_list(d, q, &triangles).unwrap();
+            let (a, b) = (scene.image(&renderer), scene.image(&oracle));
+            assert!(
+                a.foreground_pixels() >= 3_000,
+                "{}: empty image",
+                source.name()
+            );
+            assert_eq!(
+                difference(&a, &b),
+                (0, 0),
+                "{} at {ratio}: coverage differs from the oracle",
+                source.name()
+            );
+        }
+    }
+}
+
+#[test]
 fn u32_indices_draw_what_u16_indices_draw() {
     let Some(gpu) = gpu() else { return };
     // Above 65,535 vertices the renderer switches to 32-bit indices: the

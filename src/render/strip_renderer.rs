@@ -448,6 +448,42 @@ impl StripRenderer {
         Ok(upload)
     }
 
+    /// Uploads the current index buffer of any [`crate::LodSource`] (MTS or a
+    /// baseline) whole, by its topology: strips through
+    /// [`StripRenderer::upload_strip_indices`], a list through
+    /// [`StripRenderer::upload_list`]. The renderer must hold the source's
+    /// vertices ([`crate::LodSource::positions`]). For the MTS extractor,
+    /// [`StripRenderer::update_strips`] uploads only the dirty ranges.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] when a list's length is not a multiple of
+    /// three or an index is past the vertices; [`Error::Gpu`] as the upload.
+    ///
+    /// Cost: O(indices).
+    pub fn upload_source(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        source: &dyn crate::LodSource,
+    ) -> Result<Upload> {
+        match source.topology() {
+            crate::Topology::StripRestart => {
+                self.upload_strip_indices(device, queue, source.indices())
+            }
+            crate::Topology::TriangleList => {
+                let triangles: &[[u32; 3]] =
+                    bytemuck::try_cast_slice(source.indices()).map_err(|e| {
+                        Error::InvalidArgument(format!(
+                            "{}: a triangle list of {} indices ({e})",
+                            source.name(),
+                            source.indices().len()
+                        ))
+                    })?;
+                self.upload_list(device, queue, triangles)
+            }
+        }
+    }
+
     /// Records the draw of the current content into `pass` (which must have
     /// the colour and depth formats of the config). Draws nothing before
     /// the first upload.

@@ -263,7 +263,7 @@ fn measure_model(
         "methods": super::measure_methods(&model, mesh, ms(t.total), requests)?,
         "figure6": match renderer {
             #[cfg(feature = "render")]
-            Ok(r) => r.measure(&model, shares, frames)?,
+            Ok(r) => r.measure(&model, mesh, shares, frames)?,
             #[cfg(not(feature = "render"))]
             Ok(never) => match *never {},
             Err(_) => {
@@ -516,7 +516,10 @@ pub fn report(results: &Value) -> String {
     }
     let _ = writeln!(s, "\n### Table 1, every method: bytes and build time\n");
     let _ = writeln!(s, "File bytes against the raw mesh with 16-bit indices (12 per vertex + 6 per triangle, the cluster-tree paper's reference). MTS builds the whole pipeline; the baselines start from the mesh and MTS's contraction sequence (the cluster tree makes its own clustering). Multilevel has no file format of its own: its figure is the in-memory structure.\n");
-    let _ = writeln!(s, "| model | method | file bytes | file / raw 16-bit | memory bytes | build ms |");
+    let _ = writeln!(
+        s,
+        "| model | method | file bytes | file / raw 16-bit | memory bytes | build ms |"
+    );
     let _ = writeln!(s, "|---|---|---|---|---|---|");
     for r in &models {
         for m in r["methods"].as_array().into_iter().flatten() {
@@ -545,7 +548,10 @@ pub fn report(results: &Value) -> String {
         }
         let _ = writeln!(s, "{row}");
     }
-    let _ = writeln!(s, "\n### Table 2, every method: microseconds per LoD change\n");
+    let _ = writeln!(
+        s,
+        "\n### Table 2, every method: microseconds per LoD change\n"
+    );
     let _ = writeln!(s, "Each method through `LodSource::set_lod` (MTS: the coherent extractor), the same sequences over its own LoD range, in one run. The cluster tree's LoDs are its own joins; discrete LoDs only switch buffers.\n");
     let _ = writeln!(s, "| model | method | linear | exponential | random |");
     let _ = writeln!(s, "|---|---|---|---|---|");
@@ -642,36 +648,51 @@ pub fn report(results: &Value) -> String {
             "\n## Figure 6: frames per second against the share of triangles\n"
         );
         let _ = writeln!(s, "Immediate: a LoD change (extraction and upload) before every frame. Per second: one extraction (MTS from scratch; the list replayed and put in meshoptimizer's cache order) and upload per second, drawing in between. The list is meshoptimizer-ordered; MTS draws strips with primitive restart.\n");
-        let _ = writeln!(s, "| model | share | triangles | MTS immediate | MTS per second | list immediate | list per second |");
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "Each cell: immediate / one extraction per second. The baselines (through `LodSource`) upload their whole index buffer per change and are asked for their finest LoD within the MTS level's triangles.\n");
+        let _ = writeln!(
+            s,
+            "| model | share | triangles | mts | list | pm | multilevel | cluster | discrete |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
         for r in &models {
             let rows = r["figure6"]["rows"].as_array().cloned().unwrap_or_default();
-            let mut shares: Vec<f64> = rows.iter().filter_map(|x| x["share"].as_f64()).collect();
-            shares.dedup();
+            let mut shares: Vec<f64> = Vec::new();
+            for x in &rows {
+                if let Some(v) = x["share"].as_f64() {
+                    if !shares.contains(&v) {
+                        shares.push(v);
+                    }
+                }
+            }
             for share in shares {
-                let fps = |method: &str, mode: &str| {
-                    rows.iter()
-                        .find(|x| {
-                            x["share"].as_f64() == Some(share)
-                                && x["method"] == method
-                                && x["mode"] == mode
-                        })
-                        .map_or(f64::NAN, |x| f(&x["fps"]))
+                let cell = |method: &str| {
+                    let fps = |mode: &str| {
+                        rows.iter()
+                            .find(|x| {
+                                x["share"].as_f64() == Some(share)
+                                    && x["method"] == method
+                                    && x["mode"] == mode
+                            })
+                            .map_or(f64::NAN, |x| f(&x["fps"]))
+                    };
+                    format!("{:.1} / {:.1}", fps("immediate"), fps("per_second"))
                 };
                 let triangles = rows
                     .iter()
-                    .find(|x| x["share"].as_f64() == Some(share))
+                    .find(|x| x["share"].as_f64() == Some(share) && x["method"] == "mts")
                     .map_or(Value::Null, |x| x["triangles"].clone());
                 let _ = writeln!(
                     s,
-                    "| {} | {:.0}% | {} | {:.1} | {:.1} | {:.1} | {:.1} |",
+                    "| {} | {:.0}% | {} | {} | {} | {} | {} | {} | {} |",
                     r["name"].as_str().unwrap_or("?"),
                     share * 100.0,
                     triangles,
-                    fps("mts", "immediate"),
-                    fps("mts", "per_second"),
-                    fps("list", "immediate"),
-                    fps("list", "per_second"),
+                    cell("mts"),
+                    cell("list"),
+                    cell("pm"),
+                    cell("multilevel"),
+                    cell("cluster"),
+                    cell("discrete"),
                 );
             }
         }

@@ -33,9 +33,11 @@ pub fn write_all(dir: &Path, results: &Value) -> Result<Vec<PathBuf>> {
         indices_chart(&path, m)?;
         written.push(path);
         if m["figure6"]["rows"].is_array() {
-            let path = dir.join("figure6.png");
-            figure6_chart(&path, m)?;
-            written.push(path);
+            for mode in ["immediate", "per_second"] {
+                let path = dir.join(format!("figure6_{mode}.png"));
+                figure6_chart(&path, m, mode)?;
+                written.push(path);
+            }
         }
     }
     if let Some(rows) = results["scale"]["rows"].as_array() {
@@ -152,14 +154,15 @@ fn scale_chart(path: &Path, rows: &[Value]) -> Result<()> {
     Ok(())
 }
 
-/// Frames per second against the share of triangles (log axis), per
-/// method and mode: the MTS paper's Figure 6.
-fn figure6_chart(path: &Path, model: &Value) -> Result<()> {
+/// Frames per second against the share of triangles (log axis), one line
+/// per method, for one mode: the MTS paper's Figure 6 (up: `immediate`,
+/// down: `per_second`).
+fn figure6_chart(path: &Path, model: &Value, mode: &str) -> Result<()> {
     let rows = model["figure6"]["rows"]
         .as_array()
         .cloned()
         .unwrap_or_default();
-    let series = |method: &str, mode: &str| -> Vec<(f64, f64)> {
+    let series = |method: &str| -> Vec<(f64, f64)> {
         rows.iter()
             .filter(|r| r["method"] == method && r["mode"] == mode)
             .filter_map(|r| Some((r["share"].as_f64()? * 100.0, r["fps"].as_f64()?)))
@@ -167,6 +170,7 @@ fn figure6_chart(path: &Path, model: &Value) -> Result<()> {
     };
     let top = rows
         .iter()
+        .filter(|r| r["mode"] == mode)
         .filter_map(|r| r["fps"].as_f64())
         .fold(1.0f64, f64::max);
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
@@ -174,8 +178,13 @@ fn figure6_chart(path: &Path, model: &Value) -> Result<()> {
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!(
-                "Frames per second, {}",
-                model["name"].as_str().unwrap_or("?")
+                "Frames per second, {}, {}",
+                model["name"].as_str().unwrap_or("?"),
+                if mode == "immediate" {
+                    "extract + draw each frame"
+                } else {
+                    "one extraction per second"
+                }
             ),
             (FONT, 22),
         )
@@ -192,13 +201,15 @@ fn figure6_chart(path: &Path, model: &Value) -> Result<()> {
         .draw()
         .map_err(err)?;
     let lines = [
-        ("mts", "immediate", "MTS, extract + draw each frame", BLUE),
-        ("mts", "per_second", "MTS, one extraction per second", CYAN),
-        ("list", "immediate", "list, replayed each frame", RED),
-        ("list", "per_second", "list, one replay per second", MAGENTA),
+        ("mts", "MTS strips", BLUE),
+        ("list", "list (replayed)", BLACK),
+        ("pm", "progressive mesh", RED),
+        ("multilevel", "multilevel", MAGENTA),
+        ("cluster", "cluster tree", GREEN),
+        ("discrete", "discrete", CYAN),
     ]
     .into_iter()
-    .map(|(method, mode, label, color)| (label, color, series(method, mode)))
+    .map(|(method, label, color)| (label, color, series(method)))
     .collect();
     draw_lines(&mut chart, lines, SeriesLabelPosition::UpperRight)?;
     root.present().map_err(err)?;

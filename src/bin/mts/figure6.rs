@@ -12,6 +12,13 @@
 //!   program without a multiresolution structure would; per second = one
 //!   replay, reorder and upload per second.
 //!
+//! - **pm, multilevel, cluster, discrete** (the baselines, through
+//!   `LodSource`): immediate = each frame `set_lod` moves one LoD back and
+//!   forth and the whole index buffer is uploaded; per second = one
+//!   `set_lod` from the coarsest LoD and one upload per second. Each is
+//!   asked for the finest of its own LoDs within the MTS level's triangle
+//!   count.
+//!
 //! "Per second" frames are derived, not slept through: with extraction
 //! cost `e` ms and drawing cost `d` ms, a second holds `1 + (1000 − e) / d`
 //! frames.
@@ -66,8 +73,15 @@ impl Renderer {
         Ok(t.elapsed().as_secs_f64() * 1e3)
     }
 
-    /// Figure 6 rows of `model` at `shares`, `frames` timed frames each.
-    pub fn measure(&self, model: &MtsModel, shares: &[f64], frames: usize) -> Result<Value> {
+    /// Figure 6 rows of `model` (built from `input`) at `shares`, `frames`
+    /// timed frames each.
+    pub fn measure(
+        &self,
+        model: &MtsModel,
+        input: &mts::Mesh,
+        shares: &[f64],
+        frames: usize,
+    ) -> Result<Value> {
         let (d, q) = (&self.gpu.device, &self.gpu.queue);
         let camera = Camera::framing_points(model.positions(), self.target.aspect());
         let mut strips = StripRenderer::for_model(d, q, &self.config, model)?;
@@ -174,6 +188,89 @@ impl Renderer {
                 }));
             }
         }
+        for method in [
+            super::Method::Pm,
+            super::Method::Multilevel,
+            super::Method::Cluster,
+            super::Method::Discrete,
+        ] {
+            self.measure_source(method, model, input, shares, frames, &camera, &mut rows)?;
+        }
         Ok(json!({ "width": WIDTH, "height": HEIGHT, "frames": frames, "rows": rows }))
+    }
+
+    /// Figure 6 rows of one baseline (see the module documentation).
+    #[allow(clippy::too_many_arguments)]
+    fn measure_source(
+        &self,
+        method: super::Method,
+        model: &MtsModel,
+        input: &mts::Mesh,
+        shares: &[f64],
+        frames: usize,
+        camera: &Camera,
+        rows: &mut Vec<Value>,
+    ) -> Result<()> {
+        let (d, q) = (&self.gpu.device, &self.gpu.queue);
+        let mut source = super::make_source(method, model, input)?;
+        source.set_lod(0);
+        // The full mesh in the source's own vertex numbering (every
+        // baseline is a triangle list), for the renderer's normals.
+        let full: Vec<[u32; 3]> = source
+            .indices()
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        let mut renderer = StripRenderer::new(d, q, &self.config, source.positions(), &full)?;
+        renderer.set_camera(q, camera);
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        let max_lod = source.max_lod();
+        for &share in shares {
+            let budget = model.triangle_count(model.lod_for_ratio(share));
+            let lod = mts::lod::lod_for_triangles(&*source, budget);
+            let other = if lod < max_lod {
+                lod + 1
+            } else {
+                lod.saturating_sub(1)
+            };
+            let mut immediate = Vec::with_capacity(frames);
+            for i in 0..frames + 2 {
+                let t = Instant::now();
+                source.set_lod(if i % 2 == 0 { other } else { lod });
+                renderer.upload_source(d, q, &*source)?;
+                self.target.render(d, q, |pass| renderer.draw(pass))?;
+                if i >= 2 {
+                    immediate.push(t.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+            source.set_lod(max_lod);
+            let t = Instant::now();
+            source.set_lod(lod);
+            renderer.upload_source(d, q, &*source)?;
+            let extract_ms = t.elapsed().as_secs_f64() * 1e3;
+            let draw: Vec<f64> = (0..frames)
+                .map(|_| self.draw_ms(&renderer))
+                .collect::<Result<_>>()?;
+            let per_second = 1.0 + (1000.0 - extract_ms).max(0.0) / median(draw);
+            let triangles = source.triangle_count(lod);
+            for (mode, fps) in [
+                ("immediate", 1e3 / median(immediate.clone())),
+                ("per_second", per_second),
+            ] {
+                rows.push(json!({
+                    "share": share,
+                    "lod": lod,
+                    "triangles": triangles,
+                    "method": source.name(),
+                    "mode": mode,
+                    "indices_sent": source.indices().len(),
+                    "fps": fps,
+                }));
+            }
+        }
+        Ok(())
     }
 }

@@ -4,10 +4,9 @@
 use super::MeshSource;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
-use mts::model::{build, BuildOptions};
 use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
 use mts::render::{Camera, Gpu, RendererConfig, StripMode, StripRenderer};
-use mts::{stripify, Extractor, MtsModel, SimplifyOptions, StripifyOptions};
+use mts::{Extractor, MtsModel};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -19,6 +18,28 @@ pub enum Method {
     Mts,
     /// The oracle triangle list (the contraction sequence replayed).
     List,
+    /// The progressive-mesh baseline.
+    Pm,
+    /// The progressive multilevel mesh baseline.
+    Multilevel,
+    /// The cluster-tree baseline (its own LoDs: asked for the triangles of
+    /// the MTS LoD).
+    Cluster,
+    /// meshoptimizer simplify at fixed ratios.
+    Discrete,
+}
+
+impl Method {
+    /// The baseline behind this choice, if it is one.
+    fn baseline(self) -> Option<super::Method> {
+        match self {
+            Method::Mts | Method::List => None,
+            Method::Pm => Some(super::Method::Pm),
+            Method::Multilevel => Some(super::Method::Multilevel),
+            Method::Cluster => Some(super::Method::Cluster),
+            Method::Discrete => Some(super::Method::Discrete),
+        }
+    }
 }
 
 /// How strips reach the GPU.
@@ -102,12 +123,8 @@ pub fn model_of(source: &MeshSource) -> Result<(String, MtsModel)> {
         }
     }
     let (name, mesh, _) = source.load()?;
-    let strips = stripify(&mesh, &StripifyOptions::default());
-    let collapses = mts::simplify(&mesh, &SimplifyOptions::default()).collapses;
-    Ok((
-        name,
-        build(&mesh, &strips, &collapses, &BuildOptions::default()),
-    ))
+    let (model, _, _) = mts::model::build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});
+    Ok((name, model))
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
@@ -162,6 +179,23 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             let upload = renderer.upload_list(device, queue, &triangles)?;
             (3 * triangles.len(), upload)
         }
+        method => {
+            let baseline = method.baseline().expect("the other methods are baselines");
+            let mut source = super::make_source(baseline, &model, &model.mesh())?;
+            // Its own vertex numbering: a renderer over its vertices, with
+            // normals from its full mesh (every baseline is a list).
+            source.set_lod(0);
+            let full: Vec<[u32; 3]> = source
+                .indices()
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect();
+            renderer = StripRenderer::new(device, queue, &config, source.positions(), &full)?;
+            let own = mts::lod::lod_for_triangles(&*source, model.triangle_count(lod));
+            source.set_lod(own);
+            let upload = renderer.upload_source(device, queue, &*source)?;
+            (source.indices().len(), upload)
+        }
     };
     let ms_extract = t1.elapsed().as_secs_f64() * 1e3;
     renderer.set_camera(
@@ -176,6 +210,10 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let method = match args.method {
         Method::Mts => "mts",
         Method::List => "list",
+        Method::Pm => "pm",
+        Method::Multilevel => "multilevel",
+        Method::Cluster => "cluster",
+        Method::Discrete => "discrete",
     };
     if args.json {
         println!(
