@@ -293,3 +293,38 @@ fn open_models_keep_their_borders() {
     assert!(!at.is_empty());
     assert!(at.iter().all(|v| input.binary_search(v).is_ok()));
 }
+
+#[test]
+fn a_contraction_that_folds_two_neighbours_waits() {
+    // A fan of four triangles around vertex 0, seen from above (+z):
+    //
+    //             3
+    //           / |
+    //   4 ---- 0  |        0 (0, 0, 0)      3 (1, 2, 0)
+    //    \     | \ |        1 (0, -1, -0.5)  4 (-1, 0, 2)
+    //      \   |  2        2 (0.5, -0.5, 0)
+    //        \ | /
+    //           1
+    //
+    // The cheapest contraction moves 0 onto 1. It turns (0, 2, 3) by 52°
+    // and (0, 3, 4) by 5°, which the flip guard allows, but leaves them
+    // facing each other across edge (1, 3): normals 113° apart, 66°
+    // before. So 2 goes onto 1 first (along the border), after which
+    // moving 0 folds nothing.
+    let mesh = Mesh {
+        positions: vec![
+            Vec3::ZERO,
+            Vec3::new(0.0, -1.0, -0.5),
+            Vec3::new(0.5, -0.5, 0.0),
+            Vec3::new(1.0, 2.0, 0.0),
+            Vec3::new(-1.0, 0.0, 2.0),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+    };
+    let s = simplify(&mesh, &SimplifyOptions::default());
+    let c = &s.collapses;
+    check_every_lod(&mesh, c);
+    let moves: Vec<(u32, u32)> = c.steps().iter().map(|st| (st.removed, st.kept)).collect();
+    assert_eq!(moves[..2], [(2, 1), (0, 1)]);
+    assert_eq!(s.stop.reason, StopReason::NoValidPair);
+}

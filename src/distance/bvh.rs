@@ -5,7 +5,7 @@
 //! depth-first, nearer child first, pruning boxes farther than the best
 //! distance found so far.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 /// Triangles per leaf at most: 4 measured fastest for bunny-sized queries
 /// against 2 and 8 (fewer boxes against fewer triangle tests).
@@ -151,8 +151,17 @@ fn box_distance2(node: &Node, p: Vec3) -> f32 {
 /// The point of triangle `abc` closest to `p`, by the Voronoi regions of
 /// its corners, edges and face (Ericson, "Real-Time Collision Detection",
 /// section 5.1.5). Handles degenerate triangles (returns a point on them).
+///
+/// Computed in `f64`: the region tests multiply dot products (fourth
+/// powers of the coordinates), which in `f32` put a point lying on a long
+/// sliver up to 4e-5 of the diagonal off it on `alligator.obj` (coordinates
+/// near 1000), an error larger than the flat model's simplification error.
 #[must_use]
 pub fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    closest_on_triangle_f64(p.as_dvec3(), a.as_dvec3(), b.as_dvec3(), c.as_dvec3()).as_vec3()
+}
+
+fn closest_on_triangle_f64(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     let ab = b - a;
     let ac = c - a;
     let ap = p - a;
@@ -199,7 +208,7 @@ pub fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     a + ab * v + ac * w
 }
 
-fn closest_on_segment(p: Vec3, s: Vec3, e: Vec3) -> Vec3 {
+fn closest_on_segment(p: DVec3, s: DVec3, e: DVec3) -> DVec3 {
     let d = e - s;
     let len2 = d.length_squared();
     if len2 <= 0.0 {
