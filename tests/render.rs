@@ -324,6 +324,54 @@ fn baselines_through_upload_source_cover_what_the_oracle_covers() {
 }
 
 #[test]
+fn a_geomorph_runs_from_the_coarse_shape_to_the_fine_one() {
+    use mts::baselines::MultilevelMesh;
+    use mts::LodSource;
+    let Some(gpu) = gpu() else { return };
+    let mesh: Mesh = "icosphere:8k".parse::<Generated>().unwrap().build();
+    let model = model_of(&mesh);
+    let mut scene = Scene::new(&gpu, &model);
+    scene.camera.shading = Shading::Unlit;
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let config = RendererConfig {
+        color_format: COLOR_FORMAT,
+        depth_format: Some(DEPTH_FORMAT),
+        strip_mode: StripMode::Restart,
+    };
+    let mut ml = MultilevelMesh::new(&mesh, model.collapses()).unwrap();
+    let (fine, coarse) = (model.lod_for_ratio(0.5), model.lod_for_ratio(0.02));
+    let mut renderer = StripRenderer::new(d, q, &config, ml.positions(), &[]).unwrap();
+    let mut coarse_renderer = StripRenderer::new(d, q, &config, ml.positions(), &[]).unwrap();
+    ml.set_lod(coarse);
+    coarse_renderer.upload_source(d, q, &ml).unwrap();
+    let coarse_image = scene.image(&coarse_renderer);
+    ml.set_lod(fine);
+    renderer.upload_source(d, q, &ml).unwrap();
+    let fine_image = scene.image(&renderer);
+    assert!(
+        fine_image.differing_pixels(&coarse_image) > 50,
+        "the two LoDs must differ"
+    );
+    let mut morph = Vec::new();
+    // t = 0: the fine triangles on the coarse representatives' positions
+    // cover exactly what the coarse LoD covers.
+    ml.geomorph(fine, coarse, 0.0, &mut morph).unwrap();
+    renderer.update_positions(q, &morph).unwrap();
+    assert_eq!(difference(&scene.image(&renderer), &coarse_image), (0, 0));
+    // Half way it is neither; t = 1 is the fine LoD again.
+    ml.geomorph(fine, coarse, 0.5, &mut morph).unwrap();
+    renderer.update_positions(q, &morph).unwrap();
+    let half = scene.image(&renderer);
+    assert!(half.differing_pixels(&coarse_image) > 0 && half.differing_pixels(&fine_image) > 0);
+    ml.geomorph(fine, coarse, 1.0, &mut morph).unwrap();
+    renderer.update_positions(q, &morph).unwrap();
+    assert_eq!(difference(&scene.image(&renderer), &fine_image), (0, 0));
+    assert!(renderer
+        .update_positions(q, &vec![glam::Vec3::ZERO; ml.positions().len() + 1])
+        .is_err());
+}
+
+#[test]
 fn u32_indices_draw_what_u16_indices_draw() {
     let Some(gpu) = gpu() else { return };
     // Above 65,535 vertices the renderer switches to 32-bit indices: the

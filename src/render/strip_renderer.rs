@@ -85,6 +85,8 @@ pub struct StripRenderer {
     config: RendererConfig,
     vertex_buffer: wgpu::Buffer,
     vertex_count: usize,
+    /// The vertices as last uploaded (for position-only updates).
+    vertices: Vec<Vertex>,
     /// Linear RGB surface colour, written with the camera.
     colour: Vec3,
     /// One identity transform: what [`StripRenderer::draw`] binds to slot 1.
@@ -233,6 +235,7 @@ impl StripRenderer {
         Ok(StripRenderer {
             config: *config,
             vertex_buffer,
+            vertices,
             vertex_count: positions.len(),
             colour: DEFAULT_COLOUR,
             identity_instance,
@@ -446,6 +449,35 @@ impl StripRenderer {
         let upload = self.write_indices(device, queue, flat, 0..flat.len())?;
         self.draw = 0..flat.len() as u32;
         Ok(upload)
+    }
+
+    /// Moves the first `positions.len()` vertices to `positions` (normals
+    /// kept), e.g. a geomorph's interpolated positions
+    /// ([`crate::baselines::MultilevelMesh::geomorph`]) drawn with the finer
+    /// LoD's triangles.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] when there are more positions than
+    /// vertices.
+    ///
+    /// Cost: O(positions) and one upload of that prefix.
+    pub fn update_positions(&mut self, queue: &wgpu::Queue, positions: &[Vec3]) -> Result<()> {
+        if positions.len() > self.vertices.len() {
+            return Err(Error::InvalidArgument(format!(
+                "{} positions for {} vertices",
+                positions.len(),
+                self.vertices.len()
+            )));
+        }
+        for (v, p) in self.vertices.iter_mut().zip(positions) {
+            v.position = p.to_array();
+        }
+        queue.write_buffer(
+            &self.vertex_buffer,
+            0,
+            bytemuck::cast_slice(&self.vertices[..positions.len()]),
+        );
+        Ok(())
     }
 
     /// Uploads the current index buffer of any [`crate::LodSource`] (MTS or a
