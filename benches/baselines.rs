@@ -4,31 +4,18 @@
 //! sequence with the methods side by side. The bunny, or a generated 70K
 //! icosphere when `../shared/models` is absent. Throughput is per change.
 
+mod common;
+
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
-use mts::mesh::generate::Generated;
-use mts::mesh::io::{load, LoadOptions};
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
-use mts::{Extractor, LodSource, Mesh};
+use mts::{Extractor, LodSource};
 use std::hint::black_box;
-use std::path::Path;
-
-fn input() -> (String, Mesh) {
-    let bunny = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models/bunny.ply");
-    match load(&bunny, LoadOptions::default()) {
-        Ok((mesh, _)) => ("bunny".into(), mesh),
-        Err(e) => {
-            eprintln!("the bunny is missing ({e}); using icosphere:70k");
-            let g: Generated = "icosphere:70k".parse().expect("valid name");
-            ("icosphere:70k".into(), g.build())
-        }
-    }
-}
 
 const REQUESTS: usize = 100;
 
 fn bench(c: &mut Criterion) {
-    let (name, mesh) = input();
+    let (name, mesh) = common::bunny_or_generated();
     let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
     let collapses = model.collapses();
     let mut sources: Vec<Box<dyn LodSource + '_>> = vec![

@@ -10,7 +10,7 @@ mod common;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mts::model::{build, BuildOptions};
-use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
+use mts::render::headless::HeadlessTarget;
 use mts::render::{Camera, Gpu, RendererConfig, StripRenderer};
 use mts::{peers, stripify, Extractor, SimplifyOptions, StripifyOptions};
 
@@ -29,11 +29,7 @@ fn bench(c: &mut Criterion) {
     let collapses = mts::simplify(&mesh, &SimplifyOptions::default()).collapses;
     let model = build(&mesh, &strips, &collapses, &BuildOptions::default());
     let (d, q) = (&gpu.device, &gpu.queue);
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: report.strip_mode,
-    };
+    let config = RendererConfig::headless(report.strip_mode);
     let target = HeadlessTarget::new(d, 1024, 768).expect("1024x768 fits any adapter");
     let camera = Camera::framing_points(model.positions(), target.aspect());
     let mut mts_renderer = StripRenderer::for_model(d, q, &config, &model).expect("renderer");

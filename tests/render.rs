@@ -14,7 +14,7 @@ mod common;
 
 use mts::mesh::generate::Generated;
 use mts::model::{build, BuildOptions};
-use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
+use mts::render::headless::HeadlessTarget;
 use mts::render::{
     Camera, FrameStats, Gpu, Image, InstancedScene, RendererConfig, Shading, StripMode,
     StripRenderer,
@@ -71,11 +71,7 @@ impl<'g> Scene<'g> {
     }
 
     fn renderer(&self, model: &MtsModel, mode: StripMode) -> StripRenderer {
-        let config = RendererConfig {
-            color_format: COLOR_FORMAT,
-            depth_format: Some(DEPTH_FORMAT),
-            strip_mode: mode,
-        };
+        let config = RendererConfig::headless(mode);
         StripRenderer::for_model(&self.gpu.device, &self.gpu.queue, &config, model).unwrap()
     }
 
@@ -235,11 +231,7 @@ fn dirty_range_updates_equal_full_uploads() {
     assert!(model.band_count() > 1, "the walk crosses bands");
     let mut scene = Scene::new(&gpu, &model);
     let (d, q) = (&gpu.device, &gpu.queue);
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: StripMode::Restart,
-    };
+    let config = RendererConfig::headless(StripMode::Restart);
     let triangles = model.base_strips().triangles();
     // 16-bit indices (the torus's own vertices; odd range starts widen the
     // writes) and 32-bit ones (the same vertices padded past 65,535).
@@ -289,11 +281,7 @@ fn baselines_through_upload_source_cover_what_the_oracle_covers() {
     scene.camera.shading = Shading::Unlit;
     let (d, q) = (&gpu.device, &gpu.queue);
     let mut oracle = scene.renderer(&model, StripMode::Restart);
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: StripMode::Restart,
-    };
+    let config = RendererConfig::headless(StripMode::Restart);
     let sources: Vec<Box<dyn LodSource>> = vec![
         Box::new(ProgressiveMesh::new(&mesh, model.collapses()).unwrap()),
         Box::new(MultilevelMesh::new(&mesh, model.collapses()).unwrap()),
@@ -333,11 +321,7 @@ fn a_geomorph_runs_from_the_coarse_shape_to_the_fine_one() {
     let mut scene = Scene::new(&gpu, &model);
     scene.camera.shading = Shading::Unlit;
     let (d, q) = (&gpu.device, &gpu.queue);
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: StripMode::Restart,
-    };
+    let config = RendererConfig::headless(StripMode::Restart);
     let mut ml = MultilevelMesh::new(&mesh, model.collapses()).unwrap();
     let (fine, coarse) = (model.lod_for_ratio(0.5), model.lod_for_ratio(0.02));
     let mut renderer = StripRenderer::new(d, q, &config, ml.positions(), &[]).unwrap();
@@ -381,11 +365,7 @@ fn u32_indices_draw_what_u16_indices_draw() {
     let model = model_of(&mesh);
     let scene = Scene::new(&gpu, &model);
     let (d, q) = (&gpu.device, &gpu.queue);
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: StripMode::Restart,
-    };
+    let config = RendererConfig::headless(StripMode::Restart);
     let triangles = model.base_strips().triangles();
     let mut padded = model.positions().to_vec();
     padded.resize(70_000, glam::Vec3::ZERO);
@@ -457,11 +437,7 @@ fn scene_culls_and_updates_like_a_fresh_scene() {
     let mesh: Mesh = "torus:2k".parse::<Generated>().unwrap().build();
     let model = model_of(&mesh);
     let (d, q) = (&gpu.device, &gpu.queue);
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: StripMode::Restart,
-    };
+    let config = RendererConfig::headless(StripMode::Restart);
     let target = HeadlessTarget::new(d, WIDTH, HEIGHT).unwrap();
     let mut scene = InstancedScene::new(d, q, &config, &model, 100).unwrap();
     let centres: Vec<glam::Vec3> = scene.instances().iter().map(|i| i.centre).collect();

@@ -227,7 +227,8 @@ struct InfoArgs {
 /// Where a mesh comes from: a file or a built-in generator.
 #[derive(Args)]
 struct MeshSource {
-    /// OBJ or PLY file.
+    /// OBJ or PLY file (or an .mts model, for the commands that read a
+    /// model).
     #[arg(conflicts_with = "generated")]
     mesh: Option<PathBuf>,
     /// Built-in mesh NAME:SIZE, SIZE in triangles (k/M suffixes):
@@ -240,6 +241,29 @@ struct MeshSource {
 }
 
 impl MeshSource {
+    /// The model to read: an `.mts` file (recognised by its magic bytes),
+    /// or the model of the mesh, built first with the default options (a
+    /// progress bar on large inputs).
+    fn model(&self) -> Result<(String, mts::MtsModel)> {
+        if let Some(path) = &self.mesh {
+            let is_mts = std::fs::File::open(path)
+                .and_then(|mut f| {
+                    use std::io::Read;
+                    let mut magic = [0u8; 8];
+                    f.read_exact(&mut magic)
+                        .map(|()| &magic == mts::model::format::MAGIC)
+                })
+                .unwrap_or(false);
+            if is_mts {
+                let model = mts::MtsModel::load(path)?;
+                return Ok((path.display().to_string(), model));
+            }
+        }
+        let (name, mesh, _) = self.load()?;
+        let (model, _, _) = build_with_bar(&mesh, &Default::default());
+        Ok((name, model))
+    }
+
     fn load(&self) -> Result<(String, Mesh, CleanReport)> {
         let clean = CleanOptions { weld: self.weld };
         if let Some(path) = &self.mesh {
@@ -735,52 +759,10 @@ fn build_with_bar(
     out
 }
 
-/// A model to read: an `.mts` file, or a mesh whose model is built first.
+/// Which LoD a command reads: by number, triangle budget or share.
 #[derive(Args)]
-struct ModelSource {
-    /// An .mts file, or an OBJ/PLY mesh (its model is built first with the
-    /// default options).
-    #[arg(conflicts_with = "generated")]
-    input: Option<PathBuf>,
-    /// Built-in mesh NAME:SIZE (see `mts strips --help`); the default when
-    /// no input is given.
-    #[arg(long, value_name = "NAME:SIZE")]
-    generated: Option<Generated>,
-}
-
-impl ModelSource {
-    /// The model and its full-resolution mesh.
-    fn load(&self) -> Result<(String, mts::MtsModel)> {
-        if let Some(path) = &self.input {
-            let is_mts = std::fs::File::open(path)
-                .and_then(|mut f| {
-                    use std::io::Read;
-                    let mut magic = [0u8; 8];
-                    f.read_exact(&mut magic)
-                        .map(|()| &magic == mts::model::format::MAGIC)
-                })
-                .unwrap_or(false);
-            if is_mts {
-                let model = mts::MtsModel::load(path)?;
-                return Ok((path.display().to_string(), model));
-            }
-        }
-        let source = MeshSource {
-            mesh: self.input.clone(),
-            generated: self.generated,
-            weld: false,
-        };
-        let (name, mesh, _) = source.load()?;
-        let (model, _, _) = build_with_bar(&mesh, &Default::default());
-        Ok((name, model))
-    }
-}
-
-#[derive(Args)]
-#[command(group(clap::ArgGroup::new("level").required(true).args(["lod", "triangles", "ratio"])))]
-struct ExtractArgs {
-    #[command(flatten)]
-    source: ModelSource,
+#[command(group(clap::ArgGroup::new("level").args(["lod", "triangles", "ratio"])))]
+struct LevelArgs {
     /// The LoD (0 is the full mesh; clamped to the last).
     #[arg(long)]
     lod: Option<usize>,
@@ -790,6 +772,53 @@ struct ExtractArgs {
     /// The LoD with this share of the full triangle count (0..1).
     #[arg(long)]
     ratio: Option<f64>,
+}
+
+impl LevelArgs {
+    /// The LoD asked for in `source`'s own numbering (`None` when none
+    /// was given). See [`LevelArgs::resolve_in`].
+    fn resolve(&self, source: &dyn mts::LodSource) -> Result<Option<usize>> {
+        self.resolve_in(source.max_lod(), source.triangle_count(0), |n| {
+            mts::lod::lod_for_triangles(source, n)
+        })
+    }
+
+    /// The LoD of an MTS model (its own triangle table; no extractor).
+    fn resolve_model(&self, model: &mts::MtsModel) -> Result<Option<usize>> {
+        self.resolve_in(model.max_lod(), model.triangle_count(0), |n| {
+            model.lod_for_triangles(n)
+        })
+    }
+
+    /// The LoD from `max_lod`, the full triangle count and the finest LoD
+    /// within a budget: a share is the budget `ratio × full`, answered like
+    /// `--triangles`; a LoD past the last is clamped.
+    fn resolve_in(
+        &self,
+        max_lod: usize,
+        full: usize,
+        lod_for_triangles: impl Fn(usize) -> usize,
+    ) -> Result<Option<usize>> {
+        Ok(match (self.lod, self.triangles, self.ratio) {
+            (Some(l), _, _) => Some(l.min(max_lod)),
+            (_, Some(n), _) => Some(lod_for_triangles(n)),
+            (_, _, Some(r)) => {
+                if !(0.0..=1.0).contains(&r) {
+                    bail!("--ratio must be between 0 and 1, not {r}");
+                }
+                Some(lod_for_triangles((r * full as f64).round() as usize))
+            }
+            _ => None,
+        })
+    }
+}
+
+#[derive(Args)]
+struct ExtractArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    #[command(flatten)]
+    level: LevelArgs,
     /// Write the extracted triangles as OBJ.
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -853,18 +882,11 @@ fn extract(args: &ExtractArgs) -> Result<()> {
     if args.method != Method::Mts {
         return extract_baseline(args);
     }
-    let (name, model) = args.source.load()?;
-    let lod = match (args.lod, args.triangles, args.ratio) {
-        (Some(l), _, _) => l.min(model.max_lod()),
-        (_, Some(n), _) => model.lod_for_triangles(n),
-        (_, _, Some(r)) => {
-            if !(0.0..=1.0).contains(&r) {
-                bail!("--ratio must be between 0 and 1, not {r}");
-            }
-            model.lod_for_ratio(r)
-        }
-        _ => bail!("give --lod, --triangles or --ratio"),
-    };
+    let (name, model) = args.source.model()?;
+    let lod = args
+        .level
+        .resolve_model(&model)?
+        .context("give --lod, --triangles or --ratio")?;
     // Each timed extraction starts from an empty extractor (no coherence).
     let mut times = Vec::with_capacity(args.repeat.max(1));
     let mut ex = Extractor::new(&model);
@@ -919,7 +941,7 @@ fn extract(args: &ExtractArgs) -> Result<()> {
 #[derive(Args)]
 struct VerifyArgs {
     #[command(flatten)]
-    source: ModelSource,
+    source: MeshSource,
     /// `all`, or a number of LoDs spread evenly from 0 to the last.
     #[arg(long, default_value = "all")]
     lods: String,
@@ -929,7 +951,7 @@ struct VerifyArgs {
 }
 
 fn verify(args: &VerifyArgs) -> Result<bool> {
-    let (name, model) = args.source.load()?;
+    let (name, model) = args.source.model()?;
     let n = match args.lods.as_str() {
         "all" => None,
         text => Some(
@@ -1065,21 +1087,13 @@ fn main() -> std::process::ExitCode {
 }
 
 fn extract_baseline(args: &ExtractArgs) -> Result<()> {
-    let (name, model) = args.source.load()?;
+    let (name, model) = args.source.model()?;
     let mesh = model.mesh();
     let mut source = make_source(args.method, &model, &mesh)?;
-    let lod = match (args.lod, args.triangles, args.ratio) {
-        (Some(l), _, _) => l.min(source.max_lod()),
-        (_, Some(n), _) => mts::lod::lod_for_triangles(source.as_ref(), n),
-        (_, _, Some(r)) => {
-            if !(0.0..=1.0).contains(&r) {
-                bail!("--ratio must be between 0 and 1, not {r}");
-            }
-            let full = source.triangle_count(0) as f64;
-            mts::lod::lod_for_triangles(source.as_ref(), (r * full).round() as usize)
-        }
-        _ => bail!("give --lod, --triangles or --ratio"),
-    };
+    let lod = args
+        .level
+        .resolve(source.as_ref())?
+        .context("give --lod, --triangles or --ratio")?;
     // Each timed change starts from a fresh source (no coherence).
     let mut times = Vec::with_capacity(args.repeat.max(1));
     for _ in 0..args.repeat.max(1) {
@@ -1145,7 +1159,7 @@ fn encode(args: &EncodeArgs) -> Result<()> {
     let ms = t.elapsed().as_secs_f64() * 1e3;
     std::fs::write(&args.output, &bytes)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
-    let raw = 12 * mesh.vertex_count() + 6 * mesh.triangle_count();
+    let raw = mesh.raw_bytes_u16();
     if args.json {
         println!(
             "{}",
@@ -1260,7 +1274,7 @@ fn measure_methods(
     requests: usize,
 ) -> Result<Vec<serde_json::Value>> {
     use mts::model::sequence;
-    let raw = 12 * mesh.vertex_count() + 6 * mesh.triangle_count();
+    let raw = mesh.raw_bytes_u16();
     let mut rows = Vec::new();
     for method in Method::ALL {
         let t = Instant::now();
@@ -1306,7 +1320,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
     let t = Instant::now();
     let (model, _, _) = build_with_bar(&mesh, &Default::default());
     let mts_ms = t.elapsed().as_secs_f64() * 1e3;
-    let raw = 12 * mesh.vertex_count() + 6 * mesh.triangle_count();
+    let raw = mesh.raw_bytes_u16();
     let rows = measure_methods(&model, &mesh, mts_ms, args.requests)?;
     let mesh_info = json!({
         "input": name,

@@ -17,6 +17,18 @@ pub use clean::{clean, CleanOptions, CleanReport, RawMesh};
 use crate::error::{Error, Result};
 use glam::Vec3;
 
+/// Axis-aligned bounds `(min, max)` of `positions`; `None` when empty.
+/// O(n).
+#[must_use]
+pub fn bounds_of(positions: &[Vec3]) -> Option<(Vec3, Vec3)> {
+    let first = *positions.first()?;
+    Some(
+        positions
+            .iter()
+            .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
+    )
+}
+
 /// Whether a triangle repeats a vertex index (draws nothing). The one test
 /// used by loaders, cleaning, validation and strip decoding.
 #[must_use]
@@ -58,15 +70,18 @@ impl Mesh {
         self.triangles.iter().flatten().copied().collect()
     }
 
+    /// Bytes of this mesh stored raw with 16-bit indices: 12 per vertex
+    /// (three `f32`) and 6 per triangle, the reference of the cluster-tree
+    /// paper's Table 2 (see also [`crate::MtsModel::raw_bytes`]).
+    #[must_use]
+    pub fn raw_bytes_u16(&self) -> usize {
+        12 * self.vertex_count() + 6 * self.triangle_count()
+    }
+
     /// Axis-aligned bounds `(min, max)`; `None` for a mesh without vertices.
     #[must_use]
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let first = *self.positions.first()?;
-        Some(
-            self.positions
-                .iter()
-                .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))),
-        )
+        bounds_of(&self.positions)
     }
 
     /// Length of the bounding-box diagonal (0 for an empty mesh); errors are

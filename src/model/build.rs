@@ -206,27 +206,28 @@ pub fn build_with_progress(
             .unwrap_or_else(std::sync::PoisonError::into_inner)
             .expect("every segment built")
     });
-    let mut model = MtsModel {
+    let mut graphs = Part::default();
+    for part in parts {
+        graphs.append(part);
+    }
+    let model = MtsModel {
         positions: ctx.positions,
-        strip_nodes: vec![0],
-        strip_begins: vec![0],
-        band_strips: vec![0],
-        begin_node: Vec::new(),
-        begin_res: Vec::new(),
-        node_vertex: Vec::new(),
-        node_arcs: vec![0],
-        arc_target: Vec::new(),
-        arc_res: Vec::new(),
-        band_lod: Vec::new(),
+        strip_nodes: graphs.strip_nodes,
+        strip_begins: graphs.strip_begins,
+        band_strips: graphs.band_strips,
+        begin_node: graphs.begin_node,
+        begin_res: graphs.begin_res,
+        node_vertex: graphs.node_vertex,
+        node_arcs: graphs.node_arcs,
+        arc_target: graphs.arc_target,
+        arc_res: graphs.arc_res,
+        band_lod: graphs.band_lod,
         recipe: Recipe {
             strips: strips.clone(),
             collapses: collapses.clone(),
             options: options.clone(),
         },
     };
-    for part in parts {
-        part.append_to(&mut model);
-    }
     debug_assert_eq!(model.check(), Ok(()));
     model
 }
@@ -334,8 +335,9 @@ impl Context<'_> {
 }
 
 /// The graphs of consecutive bands with nodes, arcs, beginnings and strips
-/// numbered from 0; [`Part::append_to`] renumbers them into the model.
-/// Same layout as the fields of [`MtsModel`].
+/// numbered from 0; [`Part::append`] renumbers one after another, and the
+/// concatenation of every part becomes the model's arrays (same layout as
+/// the fields of [`MtsModel`]).
 struct Part {
     strip_nodes: Vec<u32>,
     strip_begins: Vec<u32>,
@@ -367,13 +369,13 @@ impl Default for Part {
 }
 
 impl Part {
-    /// Appends the part's arrays to `model`, shifting every offset and node
-    /// index by what the model already holds.
-    fn append_to(self, model: &mut MtsModel) {
-        let node_base = model.node_vertex.len() as u32;
-        let arc_base = model.arc_target.len() as u32;
-        let begin_base = model.begin_node.len() as u32;
-        let strip_base = model.strip_nodes.len() as u32 - 1;
+    /// Appends `part`'s arrays, shifting every offset and node index by
+    /// what `self` already holds.
+    fn append(&mut self, part: Part) {
+        let node_base = self.node_vertex.len() as u32;
+        let arc_base = self.arc_target.len() as u32;
+        let begin_base = self.begin_node.len() as u32;
+        let strip_base = self.strip_nodes.len() as u32 - 1;
         let shift = |t: u32| {
             if t == END {
                 END
@@ -381,25 +383,23 @@ impl Part {
                 ((t & NODE_MASK) + node_base) | (t & RESTART)
             }
         };
-        // Offset arrays start with 0, which the model already holds as its
-        // own last entry.
+        // Offset arrays start with 0, which `self` already holds as its own
+        // last entry.
         let offsets = |dst: &mut Vec<u32>, src: &[u32], base: u32| {
             dst.extend(src[1..].iter().map(|&o| o + base));
         };
-        offsets(&mut model.strip_nodes, &self.strip_nodes, node_base);
-        offsets(&mut model.strip_begins, &self.strip_begins, begin_base);
-        offsets(&mut model.node_arcs, &self.node_arcs, arc_base);
-        offsets(&mut model.band_strips, &self.band_strips, strip_base);
-        model
-            .begin_node
-            .extend(self.begin_node.iter().map(|&t| shift(t)));
-        model
-            .arc_target
-            .extend(self.arc_target.iter().map(|&t| shift(t)));
-        model.begin_res.extend_from_slice(&self.begin_res);
-        model.node_vertex.extend_from_slice(&self.node_vertex);
-        model.arc_res.extend_from_slice(&self.arc_res);
-        model.band_lod.extend_from_slice(&self.band_lod);
+        offsets(&mut self.strip_nodes, &part.strip_nodes, node_base);
+        offsets(&mut self.strip_begins, &part.strip_begins, begin_base);
+        offsets(&mut self.node_arcs, &part.node_arcs, arc_base);
+        offsets(&mut self.band_strips, &part.band_strips, strip_base);
+        self.begin_node
+            .extend(part.begin_node.iter().map(|&t| shift(t)));
+        self.arc_target
+            .extend(part.arc_target.iter().map(|&t| shift(t)));
+        self.begin_res.extend_from_slice(&part.begin_res);
+        self.node_vertex.extend_from_slice(&part.node_vertex);
+        self.arc_res.extend_from_slice(&part.arc_res);
+        self.band_lod.extend_from_slice(&part.band_lod);
     }
 }
 

@@ -92,15 +92,8 @@ impl Camera {
     /// sphere at the origin when there are none). Cost: O(positions).
     #[must_use]
     pub fn framing_points(positions: &[Vec3], aspect: f32) -> Camera {
-        let (min, max) = positions.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
-        );
-        if positions.is_empty() {
-            Camera::framing(Vec3::ZERO, Vec3::ZERO, aspect)
-        } else {
-            Camera::framing(min, max, aspect)
-        }
+        let (min, max) = crate::mesh::bounds_of(positions).unwrap_or_default();
+        Camera::framing(min, max, aspect)
     }
 }
 

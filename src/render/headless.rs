@@ -261,29 +261,59 @@ impl HeadlessTarget {
         encoder: &mut wgpu::CommandEncoder,
         draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
     ) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("mts headless pass"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &self.color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(BACKGROUND),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = begin_cleared_pass(
+            encoder,
+            "mts headless pass",
+            &self.color_view,
+            &self.depth_view,
+        );
         draw(&mut pass);
     }
+}
+
+impl crate::render::RendererConfig {
+    /// The configuration that draws into a [`HeadlessTarget`] (its colour
+    /// and depth formats), sending strips by `strip_mode`.
+    #[must_use]
+    pub fn headless(strip_mode: crate::render::StripMode) -> crate::render::RendererConfig {
+        crate::render::RendererConfig {
+            color_format: COLOR_FORMAT,
+            depth_format: Some(DEPTH_FORMAT),
+            strip_mode,
+        }
+    }
+}
+
+/// Begins a pass that clears `color` to [`BACKGROUND`] and `depth` to 1
+/// (depth is not kept after the pass): what every headless frame and every
+/// viewer frame draws into.
+pub(crate) fn begin_cleared_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    color: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: color,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(BACKGROUND),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
 }

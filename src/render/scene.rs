@@ -121,7 +121,7 @@ impl<'m> InstancedScene<'m> {
             )));
         }
         let renderer = StripRenderer::for_model(device, queue, config, model)?;
-        let (min, max) = bounds(model.positions());
+        let (min, max) = crate::mesh::bounds_of(model.positions()).unwrap_or_default();
         let radius = ((max - min).length() * 0.5).max(f32::MIN_POSITIVE);
         let spacing = 5.0 * radius;
         let side = (count as f64).sqrt().ceil() as usize;
@@ -201,19 +201,7 @@ impl<'m> InstancedScene<'m> {
             mapped_at_creation: false,
         });
         queue.write_buffer(&instance_buffer, 0, bytemuck::cast_slice(&transforms));
-        let boxes: Vec<obvhs::aabb::Aabb> = instances
-            .iter()
-            .map(|i| {
-                let r = Vec3::splat(i.radius);
-                obvhs::aabb::Aabb::new((i.centre - r).into(), (i.centre + r).into())
-            })
-            .collect();
-        let mut build_time = std::time::Duration::ZERO;
-        let bvh = obvhs::bvh2::builder::build_bvh2(
-            &boxes,
-            obvhs::BvhBuildParams::fast_build(),
-            &mut build_time,
-        );
+        let bvh = instance_bvh(&instances);
         Ok(InstancedScene {
             model,
             renderer,
@@ -394,17 +382,6 @@ fn upload_instance(
     bytes
 }
 
-/// Bounding box of `positions` (zero box when empty).
-fn bounds(positions: &[Vec3]) -> (Vec3, Vec3) {
-    if positions.is_empty() {
-        return (Vec3::ZERO, Vec3::ZERO);
-    }
-    positions.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    )
-}
-
 /// A fixed pseudo-random number in 0..1 from `i` (integer hash).
 fn hash01(i: u32) -> f32 {
     let mut x = i.wrapping_mul(0x9E37_79B9) ^ 0x85EB_CA6B;
@@ -487,6 +464,20 @@ fn sphere_in_frustum(planes: &[Vec4; 6], centre: Vec3, radius: f32) -> bool {
         .all(|p| p.truncate().dot(centre) + p.w >= -radius)
 }
 
+/// A BVH over the instances' bounding boxes (their spheres' boxes), built
+/// once: what the frustum culling walks. O(n log n).
+fn instance_bvh(instances: &[Instance]) -> obvhs::bvh2::Bvh2 {
+    let boxes: Vec<obvhs::aabb::Aabb> = instances
+        .iter()
+        .map(|i| {
+            let r = Vec3::splat(i.radius);
+            obvhs::aabb::Aabb::new((i.centre - r).into(), (i.centre + r).into())
+        })
+        .collect();
+    let mut build_time = std::time::Duration::ZERO;
+    obvhs::bvh2::builder::build_bvh2(&boxes, obvhs::BvhBuildParams::fast_build(), &mut build_time)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -508,16 +499,7 @@ mod tests {
                 }
             })
             .collect();
-        let boxes: Vec<obvhs::aabb::Aabb> = instances
-            .iter()
-            .map(|i| {
-                let r = Vec3::splat(i.radius);
-                obvhs::aabb::Aabb::new((i.centre - r).into(), (i.centre + r).into())
-            })
-            .collect();
-        let mut t = std::time::Duration::ZERO;
-        let bvh =
-            obvhs::bvh2::builder::build_bvh2(&boxes, obvhs::BvhBuildParams::fast_build(), &mut t);
+        let bvh = instance_bvh(&instances);
         let (mut stack, mut visible) = (Vec::new(), Vec::new());
         let mut seen = 0;
         for k in 0..20u32 {

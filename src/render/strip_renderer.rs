@@ -269,6 +269,37 @@ impl StripRenderer {
         StripRenderer::new(device, queue, config, model.positions(), &triangles)
     }
 
+    /// [`StripRenderer::new`] for any [`crate::LodSource`]: its own vertices
+    /// ([`crate::LodSource::positions`]), normals from its full mesh. Sets
+    /// the source to LoD 0 to read that mesh and leaves it uploaded.
+    ///
+    /// # Errors
+    /// As [`StripRenderer::new`] and [`StripRenderer::upload_source`].
+    ///
+    /// Cost: one LoD change of the source, O(vertices + triangles).
+    pub fn for_source(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: &RendererConfig,
+        source: &mut dyn crate::LodSource,
+    ) -> Result<StripRenderer> {
+        source.set_lod(0);
+        let mut full = Vec::new();
+        match source.topology() {
+            crate::Topology::StripRestart => {
+                for run in source.indices().split(|&i| i == RESTART_U32) {
+                    crate::strip::decode_run(run, &mut full);
+                }
+            }
+            crate::Topology::TriangleList => {
+                full.extend(source.indices().chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+            }
+        }
+        let mut renderer = StripRenderer::new(device, queue, config, source.positions(), &full)?;
+        renderer.upload_source(device, queue, source)?;
+        Ok(renderer)
+    }
+
     /// The formats and strip mode it was built with.
     #[must_use]
     pub fn config(&self) -> &RendererConfig {

@@ -307,7 +307,7 @@ impl<'m> State<'m> {
         let (drawn, centre, radius) = match content {
             ViewerContent::Model => {
                 let renderer = StripRenderer::for_model(&device, &queue, &renderer_config, model)?;
-                let (lo, hi) = bounds(model.positions());
+                let (lo, hi) = crate::mesh::bounds_of(model.positions()).unwrap_or_default();
                 let drawn = Drawn::Model {
                     renderer,
                     extractor: Extractor::new(model),
@@ -421,29 +421,8 @@ impl<'m> State<'m> {
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("mts viewer"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(super::headless::BACKGROUND),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass =
+                super::headless::begin_cleared_pass(&mut encoder, "mts viewer", &view, &self.depth);
             match &self.drawn {
                 Drawn::Model { renderer, .. } => renderer.draw(&mut pass),
                 Drawn::Scene(scene) => scene.draw(&mut pass),
@@ -489,14 +468,4 @@ fn depth_view(device: &wgpu::Device, width: u32, height: u32) -> wgpu::TextureVi
             view_formats: &[],
         })
         .create_view(&wgpu::TextureViewDescriptor::default())
-}
-
-fn bounds(positions: &[Vec3]) -> (Vec3, Vec3) {
-    if positions.is_empty() {
-        return (Vec3::ZERO, Vec3::ZERO);
-    }
-    positions.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    )
 }

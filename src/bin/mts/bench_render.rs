@@ -2,11 +2,11 @@
 //! against meshoptimizer-ordered triangle lists, headless, on the adapter
 //! at hand; and the cost of one LoD change (extraction plus upload).
 
-use super::render::{model_of, Size};
+use super::render::Size;
 use super::MeshSource;
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
+use mts::render::headless::HeadlessTarget;
 use mts::render::{Camera, Gpu, RendererConfig, StripRenderer};
 use mts::{peers, Extractor};
 use serde_json::json;
@@ -97,15 +97,11 @@ fn lod_change_us(
 }
 
 fn bench_render(args: &BenchRenderArgs) -> Result<()> {
-    let (name, model) = model_of(&args.source)?;
+    let (name, model) = args.source.model()?;
     let mesh = model.mesh();
     let gpu = Gpu::new_headless()?;
     let report = gpu.report();
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: report.strip_mode,
-    };
+    let config = RendererConfig::headless(report.strip_mode);
     let (d, q) = (&gpu.device, &gpu.queue);
     let target = HeadlessTarget::new(d, args.size.0, args.size.1)?;
     let camera = Camera::framing_points(model.positions(), target.aspect());

@@ -37,10 +37,10 @@ pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result
         model.band_count(),
         model.base_strips().run_count(),
     );
+    let file_bytes = model.to_bytes().len();
     println!(
-        ".mts file {} bytes = {:.2} x the raw mesh (12 bytes per vertex + 12 per triangle)",
-        model.to_bytes().len(),
-        model.to_bytes().len() as f64 / model.raw_bytes() as f64
+        ".mts file {file_bytes} bytes = {:.2} x the raw mesh (12 bytes per vertex + 12 per triangle)",
+        file_bytes as f64 / model.raw_bytes() as f64
     );
     // A sweep from the coarsest LoD to the full mesh, one LoD at a time
     // over a window, as a viewer zooming in would ask for them.
@@ -98,15 +98,11 @@ pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result
 /// PNG (headless; Mesa's lavapipe without a GPU) and says what it drew.
 #[cfg(feature = "render")]
 fn render_thumbnails(model: &mts::MtsModel, path: &std::path::Path) -> Result<String> {
-    use mts::render::headless::{HeadlessTarget, Image, COLOR_FORMAT, DEPTH_FORMAT};
+    use mts::render::headless::{HeadlessTarget, Image};
     use mts::render::{Camera, Gpu, RendererConfig, StripRenderer};
     let gpu = Gpu::new_headless()?;
     let report = gpu.report();
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: report.strip_mode,
-    };
+    let config = RendererConfig::headless(report.strip_mode);
     let (device, queue) = (&gpu.device, &gpu.queue);
     let mut renderer = StripRenderer::for_model(device, queue, &config, model)?;
     let target = HeadlessTarget::new(device, THUMBNAIL, THUMBNAIL)?;

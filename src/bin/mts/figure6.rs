@@ -24,7 +24,7 @@
 //! frames.
 
 use anyhow::Result;
-use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
+use mts::render::headless::HeadlessTarget;
 use mts::render::{Camera, Gpu, RendererConfig, StripRenderer};
 use mts::{peers, Extractor, MtsModel};
 use serde_json::{json, Value};
@@ -46,11 +46,7 @@ impl Renderer {
     pub fn new() -> Result<Renderer> {
         let gpu = Gpu::new_headless()?;
         let report = gpu.report();
-        let config = RendererConfig {
-            color_format: COLOR_FORMAT,
-            depth_format: Some(DEPTH_FORMAT),
-            strip_mode: report.strip_mode,
-        };
+        let config = RendererConfig::headless(report.strip_mode);
         let target = HeadlessTarget::new(&gpu.device, WIDTH, HEIGHT)?;
         Ok(Renderer {
             gpu,
@@ -117,13 +113,11 @@ impl Renderer {
                     immediate.push(t.elapsed().as_secs_f64() * 1e3);
                 }
             }
-            // mts, one extraction per second.
-            ex.set_lod(lod);
-            strips.update_strips(d, q, &ex)?;
+            // mts, one extraction per second: every strip walked again
+            // and the buffer uploaded whole.
             let t = Instant::now();
-            let mut fresh = Extractor::new(model);
-            fresh.set_lod_from_scratch(lod);
-            strips.upload_strips(d, q, &fresh)?;
+            ex.set_lod_from_scratch(lod);
+            strips.upload_strips(d, q, &ex)?;
             let extract_ms = t.elapsed().as_secs_f64() * 1e3;
             let draw: Vec<f64> = (0..frames)
                 .map(|_| self.draw_ms(&strips))
@@ -213,15 +207,7 @@ impl Renderer {
     ) -> Result<()> {
         let (d, q) = (&self.gpu.device, &self.gpu.queue);
         let mut source = super::make_source(method, model, input)?;
-        source.set_lod(0);
-        // The full mesh in the source's own vertex numbering (every
-        // baseline is a triangle list), for the renderer's normals.
-        let full: Vec<[u32; 3]> = source
-            .indices()
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
-        let mut renderer = StripRenderer::new(d, q, &self.config, source.positions(), &full)?;
+        let mut renderer = StripRenderer::for_source(d, q, &self.config, source.as_mut())?;
         renderer.set_camera(q, camera);
         let median = |mut v: Vec<f64>| {
             v.sort_by(f64::total_cmp);

@@ -1,10 +1,10 @@
 //! `mts render`: one LoD of a model drawn headless into a PNG, by the MTS
 //! strips or by the oracle triangle list, through `mts::render`.
 
-use super::MeshSource;
-use anyhow::{bail, Context, Result};
+use super::{LevelArgs, MeshSource};
+use anyhow::Result;
 use clap::{Args, ValueEnum};
-use mts::render::headless::{HeadlessTarget, COLOR_FORMAT, DEPTH_FORMAT};
+use mts::render::headless::HeadlessTarget;
 use mts::render::{Camera, Gpu, RendererConfig, StripMode, StripRenderer};
 use mts::{Extractor, MtsModel};
 use serde_json::json;
@@ -73,20 +73,13 @@ impl std::str::FromStr for Size {
 }
 
 #[derive(Args)]
-#[command(group(clap::ArgGroup::new("level").args(["lod", "triangles", "ratio"])))]
 pub struct RenderArgs {
     /// An .mts model, or an OBJ/PLY mesh (the model is built on the fly).
     #[command(flatten)]
     source: MeshSource,
-    /// The LoD to draw (0 = full mesh; the default).
-    #[arg(long)]
-    lod: Option<usize>,
-    /// Draw the finest LoD with at most this many triangles.
-    #[arg(long)]
-    triangles: Option<usize>,
-    /// Draw the LoD with this share of the triangles (0..1).
-    #[arg(long)]
-    ratio: Option<f64>,
+    /// The LoD to draw (the full mesh when none is given).
+    #[command(flatten)]
+    level: LevelArgs,
     /// The PNG to write.
     #[arg(short, long)]
     output: PathBuf,
@@ -109,48 +102,15 @@ pub struct RenderArgs {
     scene: Option<usize>,
 }
 
-/// The model of `source`: loaded from an .mts file, or built from the mesh
-/// (strips, contraction sequence, default options).
-pub fn model_of(source: &MeshSource) -> Result<(String, MtsModel)> {
-    if let Some(path) = &source.mesh {
-        if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("mts"))
-        {
-            let model = MtsModel::load(path)
-                .with_context(|| format!("cannot load the model {}", path.display()))?;
-            return Ok((path.display().to_string(), model));
-        }
-    }
-    let (name, mesh, _) = source.load()?;
-    let (model, _, _) = mts::model::build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});
-    Ok((name, model))
-}
-
 pub fn render(args: &RenderArgs) -> Result<()> {
     let Size(width, height) = args.size;
     let t0 = Instant::now();
-    let (name, model) = model_of(&args.source)?;
+    let (name, model) = args.source.model()?;
     let ms_model = t0.elapsed().as_secs_f64() * 1e3;
     if let Some(count) = args.scene {
         return render_scene(args, &name, &model, count);
     }
-    let lod = match (args.lod, args.triangles, args.ratio) {
-        (Some(k), _, _) => {
-            if k > model.max_lod() {
-                bail!("--lod {k} is past the last LoD {}", model.max_lod());
-            }
-            k
-        }
-        (_, Some(n), _) => model.lod_for_triangles(n),
-        (_, _, Some(r)) => {
-            if !(0.0..=1.0).contains(&r) {
-                bail!("--ratio {r} is outside 0..1");
-            }
-            model.lod_for_ratio(r)
-        }
-        _ => 0,
-    };
+    let lod = args.level.resolve_model(&model)?.unwrap_or(0);
     let gpu = Gpu::new_headless()?;
     let mut report = gpu.report();
     report.strip_mode = match args.strip_mode {
@@ -158,43 +118,33 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         StripModeArg::Restart => StripMode::Restart,
         StripModeArg::Stitched => StripMode::Stitched,
     };
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: report.strip_mode,
-    };
+    let config = RendererConfig::headless(report.strip_mode);
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let mut renderer = StripRenderer::for_model(device, queue, &config, &model)?;
     let target = HeadlessTarget::new(device, width, height)?;
     let t1 = Instant::now();
-    let (indices_sent, upload) = match args.method {
-        Method::Mts => {
-            let mut ex = Extractor::new(&model);
-            ex.set_lod(lod);
-            let upload = renderer.upload_strips(device, queue, &ex)?;
-            (ex.indices_sent(), upload)
-        }
-        Method::List => {
-            let triangles = model.collapses().triangles_at(&model.mesh(), lod);
-            let upload = renderer.upload_list(device, queue, &triangles)?;
-            (3 * triangles.len(), upload)
-        }
-        method => {
-            let baseline = method.baseline().expect("the other methods are baselines");
-            let mut source = super::make_source(baseline, &model, &model.mesh())?;
-            // Its own vertex numbering: a renderer over its vertices, with
-            // normals from its full mesh (every baseline is a list).
-            source.set_lod(0);
-            let full: Vec<[u32; 3]> = source
-                .indices()
-                .chunks_exact(3)
-                .map(|c| [c[0], c[1], c[2]])
-                .collect();
-            renderer = StripRenderer::new(device, queue, &config, source.positions(), &full)?;
+    let (renderer, indices_sent, upload) = match args.method.baseline() {
+        // A baseline numbers its vertices its own way: a renderer over them,
+        // and its finest LoD within the MTS LoD's triangles.
+        Some(b) => {
+            let mut source = super::make_source(b, &model, &model.mesh())?;
+            let mut r = StripRenderer::for_source(device, queue, &config, source.as_mut())?;
             let own = mts::lod::lod_for_triangles(&*source, model.triangle_count(lod));
             source.set_lod(own);
-            let upload = renderer.upload_source(device, queue, &*source)?;
-            (source.indices().len(), upload)
+            let upload = r.upload_source(device, queue, &*source)?;
+            (r, source.indices().len(), upload)
+        }
+        None => {
+            let mut r = StripRenderer::for_model(device, queue, &config, &model)?;
+            if args.method == Method::Mts {
+                let mut ex = Extractor::new(&model);
+                ex.set_lod(lod);
+                let upload = r.upload_strips(device, queue, &ex)?;
+                (r, ex.indices_sent(), upload)
+            } else {
+                let triangles = model.collapses().triangles_at(&model.mesh(), lod);
+                let upload = r.upload_list(device, queue, &triangles)?;
+                (r, 3 * triangles.len(), upload)
+            }
         }
     };
     let ms_extract = t1.elapsed().as_secs_f64() * 1e3;
@@ -278,11 +228,7 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     let gpu = Gpu::new_headless()?;
     let report = gpu.report();
     // The scene needs primitive restart: on GL this is a clear error.
-    let config = RendererConfig {
-        color_format: COLOR_FORMAT,
-        depth_format: Some(DEPTH_FORMAT),
-        strip_mode: report.strip_mode,
-    };
+    let config = RendererConfig::headless(report.strip_mode);
     let (device, queue) = (&gpu.device, &gpu.queue);
     let target = HeadlessTarget::new(device, width, height)?;
     let mut scene = InstancedScene::new(device, queue, &config, model, count)?;
@@ -368,7 +314,7 @@ pub struct ViewArgs {
 #[cfg(feature = "viewer")]
 pub fn view(args: &ViewArgs) -> Result<()> {
     use mts::render::viewer::{run, ViewerContent};
-    let (name, model) = model_of(&args.source)?;
+    let (name, model) = args.source.model()?;
     let content = match args.scene {
         Some(n) => ViewerContent::Scene(n),
         None => ViewerContent::Model,
