@@ -157,14 +157,11 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let ms_render = t2.elapsed().as_secs_f64() * 1e3;
     image.save_png(&args.output)?;
     let triangles = model.triangle_count(lod);
-    let method = match args.method {
-        Method::Mts => "mts",
-        Method::List => "list",
-        Method::Pm => "pm",
-        Method::Multilevel => "multilevel",
-        Method::Cluster => "cluster",
-        Method::Discrete => "discrete",
-    };
+    // The name the command line spells it with.
+    let method = args
+        .method
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string());
     if args.json {
         println!(
             "{}",
