@@ -26,6 +26,8 @@ mod figure6;
 #[cfg(feature = "render")]
 #[path = "mts/render.rs"]
 mod render;
+#[path = "mts/summary.rs"]
+mod summary;
 
 #[derive(Parser)]
 #[command(
@@ -95,12 +97,91 @@ struct DemoArgs {
     thumbnails: PathBuf,
 }
 
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Frames and triangles per second: MTS strips against
+    /// meshoptimizer-ordered triangle lists at 100%, 50% and 10%.
+    #[cfg(feature = "render")]
+    Render(bench_render::BenchRenderArgs),
+    /// The README's "Latest bench report" section, made from a report's
+    /// results.json.
+    Summary(SummaryArgs),
+}
+
+#[derive(Args)]
+struct SummaryArgs {
+    /// The report's results.json.
+    results: PathBuf,
+    /// Rewrite this README's generated section in place.
+    #[arg(long)]
+    readme: Option<PathBuf>,
+    /// With --readme: change nothing, fail when the section differs from
+    /// what the results give.
+    #[arg(long, requires = "readme")]
+    check: bool,
+}
+
+fn bench_summary(args: &SummaryArgs) -> Result<()> {
+    let path = &args.results;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let results: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not a bench results.json", path.display()))?;
+    if results["schema"].as_u64() != Some(u64::from(bench::SCHEMA_VERSION)) {
+        bail!(
+            "{}: schema {} where this build reads {} (run mts bench again)",
+            path.display(),
+            results["schema"],
+            bench::SCHEMA_VERSION
+        );
+    }
+    let Some(readme) = &args.readme else {
+        let dir = path
+            .parent()
+            .map_or_else(String::new, |p| p.display().to_string());
+        print!("{}", summary::summary(&results, &dir));
+        return Ok(());
+    };
+    // Links are relative to the README.
+    let base = readme.parent().unwrap_or(std::path::Path::new(""));
+    let dir = path
+        .parent()
+        .map(|p| p.strip_prefix(base).unwrap_or(p).display().to_string())
+        .unwrap_or_default();
+    let section = summary::summary(&results, &dir);
+    let old = std::fs::read_to_string(readme)
+        .with_context(|| format!("cannot read {}", readme.display()))?;
+    let Some(new) = summary::splice(&old, &section) else {
+        bail!(
+            "{} has no generated section: put the two lines\n{}\n{}\nwhere it goes",
+            readme.display(),
+            summary::BEGIN,
+            summary::END
+        );
+    };
+    if args.check {
+        if new != old {
+            bail!(
+                "{}'s bench section differs from {}: run `mts bench summary {} --readme {}`",
+                readme.display(),
+                path.display(),
+                path.display(),
+                readme.display()
+            );
+        }
+        println!("{} matches {}", readme.display(), path.display());
+        return Ok(());
+    }
+    std::fs::write(readme, new).with_context(|| format!("cannot write {}", readme.display()))?;
+    println!("rewrote the bench section of {}", readme.display());
+    Ok(())
+}
+
 #[derive(Args)]
 #[command(args_conflicts_with_subcommands = true)]
 struct BenchArgs {
-    #[cfg(feature = "render")]
     #[command(subcommand)]
-    command: Option<bench_render::BenchCommand>,
+    command: Option<BenchCommand>,
     /// Meshes, or folders whose .obj and .ply files are all measured.
     /// Default: ../shared/models when it exists, else the built-in mesh.
     #[arg(long, num_args = 1..)]
@@ -118,9 +199,11 @@ struct BenchArgs {
 }
 
 fn bench_cmd(args: &BenchArgs) -> Result<()> {
-    #[cfg(feature = "render")]
-    if let Some(command) = &args.command {
-        return bench_render::bench(command);
+    match &args.command {
+        #[cfg(feature = "render")]
+        Some(BenchCommand::Render(args)) => return bench_render::bench_render(args),
+        Some(BenchCommand::Summary(args)) => return bench_summary(args),
+        None => {}
     }
     let mut models = Vec::new();
     let mut sources = args.models.clone();
@@ -153,9 +236,10 @@ fn bench_cmd(args: &BenchArgs) -> Result<()> {
         command: std::env::args().collect::<Vec<_>>().join(" "),
         render: !args.no_render,
     };
-    let results = bench::run(&options, &|what| {
+    let mut results = bench::run(&options, &|what| {
         bar.set_message(format!("measuring {what}"))
     })?;
+    results["elapsed_s"] = json!(t.elapsed().as_secs_f64());
     bar.finish_and_clear();
     bench::write(&args.out, &results)?;
     println!(

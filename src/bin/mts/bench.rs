@@ -10,14 +10,15 @@ use mts::distance::{surface_distance, Surface};
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
 use mts::peers;
 use mts::strip::encode::RESTART_U32;
-use mts::{Extractor, Mesh, MtsModel};
+use mts::strip::stats::StripStats;
+use mts::{Extractor, Mesh, MtsModel, SimplifyOptions, StripifyOptions};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 1;
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// Shares of the full triangle count reported in Tables 3–4.
 const SHARES: [f64; 6] = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
@@ -30,6 +31,13 @@ const QUICK_REQUESTS: usize = 200;
 const SCALE_SIZES: [&str; 6] = ["10k", "40k", "160k", "640k", "1M", "4M"];
 /// Surface samples per side for the quality section.
 const SAMPLES: usize = 100_000;
+/// Timed runs of the stripifiers and simplifiers per model (medians);
+/// `--quick` uses fewer.
+const STAGE_REPEAT: usize = 7;
+const QUICK_STAGE_REPEAT: usize = 3;
+/// Instances of the scene row (Figure 6's adapter), and with `--quick`.
+const SCENE_INSTANCES: usize = 1000;
+const QUICK_SCENE_INSTANCES: usize = 250;
 
 /// What to measure.
 pub struct BenchOptions {
@@ -99,12 +107,18 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
     } else {
         (&FIGURE6_SHARES, FIGURE6_FRAMES)
     };
+    let repeat = if options.quick {
+        QUICK_STAGE_REPEAT
+    } else {
+        STAGE_REPEAT
+    };
     for (name, mesh) in &inputs {
         progress(name);
         models.push(measure_model(
-            name, mesh, requests, &renderer, shares, frames,
+            name, mesh, requests, repeat, &renderer, shares, frames,
         )?);
     }
+    let scene = measure_scene(&inputs, options.quick, frames, &renderer, progress)?;
     let scale = if options.quick {
         Value::Null
     } else {
@@ -117,6 +131,7 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
         "quick": options.quick,
         "machine": machine(&renderer),
         "models": models,
+        "scene": scene,
         "scale": scale,
         "fast_simplification": if options.quick {
             Value::Null
@@ -226,10 +241,110 @@ fn time_us(repeat: usize, mut f: impl FnMut()) -> f64 {
     )
 }
 
+/// The scene row: [`SCENE_INSTANCES`] instances (fewer with `--quick`) of
+/// the bunny when it is measured, else of the first model, on Figure 6's
+/// adapter; `null` without one.
+fn measure_scene(
+    inputs: &[(String, Mesh)],
+    quick: bool,
+    frames: usize,
+    renderer: &Figure6,
+    progress: &dyn Fn(&str),
+) -> Result<Value> {
+    let Some((name, mesh)) = inputs
+        .iter()
+        .find(|(n, _)| n == "bunny.ply")
+        .or(inputs.first())
+    else {
+        return Ok(Value::Null);
+    };
+    let instances = if quick {
+        QUICK_SCENE_INSTANCES
+    } else {
+        SCENE_INSTANCES
+    };
+    match renderer {
+        #[cfg(feature = "render")]
+        Ok(r) => {
+            progress(&format!("scene of {instances} × {name}"));
+            let (model, _, _) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
+            let mut row = r.measure_scene(&model, instances, frames)?;
+            row["model"] = Value::from(name.as_str());
+            Ok(row)
+        }
+        #[cfg(not(feature = "render"))]
+        Ok(never) => match *never {},
+        Err(_) => {
+            let _ = (name, mesh, instances, frames, progress);
+            Ok(Value::Null)
+        }
+    }
+}
+
+/// Medians of `repeat` interleaved runs of `a` and `b` (so that a drift of
+/// the machine's speed hits both alike), in milliseconds, with the last
+/// results.
+fn interleaved_ms<A, B>(
+    repeat: usize,
+    mut a: impl FnMut() -> A,
+    mut b: impl FnMut() -> B,
+) -> ((A, f64), (B, f64)) {
+    let (mut ta, mut tb) = (Vec::new(), Vec::new());
+    let (mut ra, mut rb) = (None, None);
+    for _ in 0..repeat.max(1) {
+        let t = Instant::now();
+        ra = Some(a());
+        ta.push(t.elapsed().as_secs_f64() * 1e3);
+        let t = Instant::now();
+        rb = Some(b());
+        tb.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    (
+        (ra.expect("one run"), median(ta)),
+        (rb.expect("one run"), median(tb)),
+    )
+}
+
+/// The project's stripifier against meshoptimizer's on `mesh` (the `mts
+/// strips` row): both strip sets' figures and median milliseconds.
+fn measure_stripify(mesh: &Mesh, repeat: usize) -> Value {
+    let options = StripifyOptions::default();
+    let ((ours, ms), (theirs, their_ms)) = interleaved_ms(
+        repeat,
+        || mts::stripify(mesh, &options),
+        || peers::meshopt::stripify(mesh),
+    );
+    let mut v = super::stats_json(&StripStats::new(&ours, ms));
+    v["meshopt"] = super::stats_json(&StripStats::new(&theirs, their_ms));
+    v
+}
+
+/// The whole contraction sequence (default options) against
+/// meshoptimizer's `simplify` to 10% and to 1% of the triangles, median
+/// milliseconds of interleaved runs.
+fn measure_simplify(mesh: &Mesh, repeat: usize) -> Value {
+    let n = mesh.triangle_count();
+    let ((whole, ms), (_, to_10)) = interleaved_ms(
+        repeat,
+        || mts::simplify(mesh, &SimplifyOptions::default()),
+        || peers::meshopt::simplify(mesh, n / 10),
+    );
+    let (_, (_, to_1)) = interleaved_ms(1, || (), || peers::meshopt::simplify(mesh, n / 100));
+    json!({
+        "ms": ms,
+        "max_lod": whole.collapses.max_lod(),
+        "stop": whole.stop.to_string(),
+        "meshopt_ms_to_10": to_10,
+        "meshopt_ms_to_1": to_1,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
 fn measure_model(
     name: &str,
     mesh: &Mesh,
     requests: usize,
+    repeat: usize,
     renderer: &Figure6,
     shares: &[f64],
     frames: usize,
@@ -257,6 +372,8 @@ fn measure_model(
             "model": ms(t.model),
             "total": ms(t.total),
         },
+        "stripify": measure_stripify(mesh, repeat),
+        "simplify": measure_simplify(mesh, repeat),
         "extraction": measure_sequences(&model, requests),
         "levels": measure_levels(&model),
         "quality": measure_quality(mesh, &model),
@@ -413,11 +530,31 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Value {
         let extract_us = time_us(5, || {
             ex.set_lod_from_scratch(0);
         });
+        let (model_bytes, rss) = (model.stats().memory_bytes, peak_rss());
+        drop(ex);
+        drop(model);
+        // Each stage alone (the pipeline runs stripify beside simplify),
+        // against meshoptimizer, one run each.
+        let ((_, stripify_ms), (_, meshopt_stripify_ms)) = interleaved_ms(
+            1,
+            || mts::stripify(&mesh, &StripifyOptions::default()),
+            || peers::meshopt::stripify(&mesh),
+        );
+        let n = mesh.triangle_count();
+        let ((_, simplify_ms), (_, meshopt_simplify_ms)) = interleaved_ms(
+            1,
+            || mts::simplify(&mesh, &SimplifyOptions::default()),
+            || peers::meshopt::simplify(&mesh, n / 10),
+        );
         rows.push(json!({
             "triangles": mesh.triangle_count(),
+            "stripify_ms": stripify_ms,
+            "meshopt_stripify_ms": meshopt_stripify_ms,
+            "simplify_ms": simplify_ms,
+            "meshopt_simplify_to_10_ms": meshopt_simplify_ms,
             "build_ms": t.total.as_secs_f64() * 1e3,
-            "model_bytes": model.stats().memory_bytes,
-            "peak_rss_bytes": peak_rss(),
+            "model_bytes": model_bytes,
+            "peak_rss_bytes": rss,
             "extract_lod0_us": extract_us,
         }));
     }
@@ -433,6 +570,8 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Value {
     json!({
         "rows": rows,
         "exponent": {
+            "stripify_ms": fit("stripify_ms"),
+            "simplify_ms": fit("simplify_ms"),
             "build_ms": fit("build_ms"),
             "model_bytes": fit("model_bytes"),
             "extract_lod0_us": fit("extract_lod0_us"),
@@ -477,8 +616,11 @@ pub fn report(results: &Value) -> String {
     let _ = writeln!(s, "# mts bench report\n");
     let _ = writeln!(
         s,
-        "Command: `{}`. Machine: {} ({} cores), {}. Graphics adapter (Figure 6): {}.\n",
+        "Command: `{}`{}. Machine: {} ({} cores), {}. Graphics adapter (Figure 6): {}.\n",
         results["command"].as_str().unwrap_or(""),
+        results["elapsed_s"]
+            .as_f64()
+            .map_or_else(String::new, |e| format!(", {e:.0} s")),
         m["cpu"].as_str().unwrap_or("?"),
         m["cores"],
         m["os"].as_str().unwrap_or("?"),
@@ -512,6 +654,31 @@ pub fn report(results: &Value) -> String {
             f(&t["simplify"]),
             f(&t["model"]),
             f(&t["total"]),
+        );
+    }
+    let _ = writeln!(s, "\n## Strips against meshoptimizer\n");
+    let _ = writeln!(s, "The project's stripifier (adjacency included) against meshoptimizer's `optimize_vertex_cache_strip` + `stripify` on the input mesh, restart encoding; medians of interleaved runs. Each cell: mts / meshopt.\n");
+    let _ = writeln!(s, "| model | triangles | strips | swaps | indices (restart) | indices per triangle | ACMR | ms |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        let (a, b) = (&r["stripify"], &r["stripify"]["meshopt"]);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} / {} | {} / {} | {} / {} | {:.4} / {:.4} | {:.3} / {:.3} | {:.1} / {:.1} |",
+            r["name"].as_str().unwrap_or("?"),
+            a["triangles"],
+            a["strips"],
+            b["strips"],
+            a["swaps"],
+            b["swaps"],
+            a["indices_restart"],
+            b["indices_restart"],
+            f(&a["indices_per_triangle"]),
+            f(&b["indices_per_triangle"]),
+            f(&a["acmr"]),
+            f(&b["acmr"]),
+            f(&a["ms"]),
+            f(&b["ms"]),
         );
     }
     let _ = writeln!(s, "\n### Table 1, every method: bytes and build time\n");
@@ -608,6 +775,24 @@ pub fn report(results: &Value) -> String {
     if let Some(why) = results["fast_simplification"]["skipped"].as_str() {
         let _ = writeln!(s, "fast-simplification not measured: {why}.\n");
     }
+    let _ = writeln!(s, "Speed: the project's whole contraction sequence (every LoD, default options) against meshoptimizer's `simplify` to 10% and to 1%, medians of interleaved runs in milliseconds.\n");
+    let _ = writeln!(s, "| model | triangles | contractions | mts whole sequence | meshopt to 10% | meshopt to 1% | stopped |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    for r in &models {
+        let x = &r["simplify"];
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.1} | {:.1} | {:.1} | {} |",
+            r["name"].as_str().unwrap_or("?"),
+            r["triangles"],
+            x["max_lod"],
+            f(&x["ms"]),
+            f(&x["meshopt_ms_to_10"]),
+            f(&x["meshopt_ms_to_1"]),
+            x["stop"].as_str().unwrap_or("?"),
+        );
+    }
+    let _ = writeln!(s);
     let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts | Hausdorff meshopt | ratio | RMS mts | RMS meshopt | fast-simplification triangles, Hausdorff, RMS |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
     for r in &models {
@@ -697,15 +882,81 @@ pub fn report(results: &Value) -> String {
             }
         }
     }
+    if models.iter().any(|r| r["figure6"].is_object()) {
+        let _ = writeln!(s, "\n### Figure 6, draw time per frame\n");
+        let _ = writeln!(s, "The same runs: the median time of one frame drawn without a LoD change (submit and wait), MTS strips against the meshoptimizer-ordered list, and the median time of one MTS LoD change (extraction and dirty-range upload, one LoD step back and forth).\n");
+        let _ = writeln!(s, "| model | share | triangles | indices mts / list | draw ms mts / list | Mtri/s mts / list | MTS LoD change µs |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        for r in &models {
+            let rows = r["figure6"]["rows"].as_array().cloned().unwrap_or_default();
+            let find = |x: &Value, method: &str| {
+                rows.iter()
+                    .find(|y| {
+                        y["share"] == x["share"]
+                            && y["method"] == method
+                            && y["mode"] == "immediate"
+                    })
+                    .cloned()
+                    .unwrap_or(Value::Null)
+            };
+            for x in rows
+                .iter()
+                .filter(|x| x["method"] == "mts" && x["mode"] == "immediate")
+            {
+                let list = find(x, "list");
+                let tri = f(&x["triangles"]);
+                let _ = writeln!(
+                    s,
+                    "| {} | {:.0}% | {} | {} / {} | {:.2} / {:.2} | {:.2} / {:.2} | {:.0} |",
+                    r["name"].as_str().unwrap_or("?"),
+                    f(&x["share"]) * 100.0,
+                    x["triangles"],
+                    x["indices_sent"],
+                    list["indices_sent"],
+                    f(&x["draw_ms"]),
+                    f(&list["draw_ms"]),
+                    tri / f(&x["draw_ms"]) / 1e3,
+                    tri / f(&list["draw_ms"]) / 1e3,
+                    f(&x["change_us"]),
+                );
+            }
+        }
+    }
+    let scene = &results["scene"];
+    if scene.is_object() {
+        let _ = writeln!(s, "\n## Scene: many instances, each with its own LoD\n");
+        let _ = writeln!(s, "`mts bench render`'s scene row on Figure 6's adapter: instances on a ground plane seen by the overview camera, culled by the instance BVH, each given the finest LoD with at most one triangle per 4 projected pixels and its own coherence cache. Frame: every instance's update and the draw, median.\n");
+        let _ = writeln!(s, "| model | instances | visible | triangles | indices sent | CPU bytes per instance | first update ms | ms per frame | fps | Mtri/s |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.2} |",
+            scene["model"].as_str().unwrap_or("?"),
+            scene["instances"],
+            scene["visible"],
+            scene["triangles"],
+            scene["indices_sent"],
+            scene["cpu_bytes_per_instance"],
+            f(&scene["ms_first_update"]),
+            f(&scene["ms_per_frame"]),
+            f(&scene["fps"]),
+            f(&scene["triangles_per_second"]) / 1e6,
+        );
+    }
     if let Some(rows) = results["scale"]["rows"].as_array() {
         let _ = writeln!(s, "\n## Scale: generated icospheres\n");
-        let _ = writeln!(s, "| triangles | build ms | model bytes | peak RSS bytes (process so far) | LoD 0 extraction µs |");
-        let _ = writeln!(s, "|---|---|---|---|---|");
+        let _ = writeln!(s, "Stripify and simplify (whole sequence) each timed alone, beside meshoptimizer's `stripify` and `simplify` to 10%; build is the whole pipeline (stripify beside simplify, then the model).\n");
+        let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes | peak RSS bytes (process so far) | LoD 0 extraction µs |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
         for r in rows {
             let _ = writeln!(
                 s,
-                "| {} | {:.0} | {} | {} | {:.0} |",
+                "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} | {} | {:.0} |",
                 r["triangles"],
+                f(&r["stripify_ms"]),
+                f(&r["meshopt_stripify_ms"]),
+                f(&r["simplify_ms"]),
+                f(&r["meshopt_simplify_to_10_ms"]),
                 f(&r["build_ms"]),
                 r["model_bytes"],
                 r["peak_rss_bytes"],
@@ -715,7 +966,9 @@ pub fn report(results: &Value) -> String {
         let e = &results["scale"]["exponent"];
         let _ = writeln!(
             s,
-            "\nFitted growth exponents (y ~ triangles^k): build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.",
+            "\nFitted growth exponents (y ~ triangles^k): stripify {:.2}, simplify {:.2}, build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.",
+            f(&e["stripify_ms"]),
+            f(&e["simplify_ms"]),
             f(&e["build_ms"]),
             f(&e["model_bytes"]),
             f(&e["extract_lod0_us"]),

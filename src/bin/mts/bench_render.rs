@@ -5,19 +5,12 @@
 use super::render::Size;
 use super::MeshSource;
 use anyhow::Result;
-use clap::{Args, Subcommand};
+use clap::Args;
 use mts::render::headless::HeadlessTarget;
 use mts::render::{Camera, Gpu, RendererConfig, StripRenderer};
 use mts::{peers, Extractor};
 use serde_json::json;
 use std::time::Instant;
-
-#[derive(Subcommand)]
-pub enum BenchCommand {
-    /// Frames and triangles per second: MTS strips against
-    /// meshoptimizer-ordered triangle lists at 100%, 50% and 10%.
-    Render(BenchRenderArgs),
-}
 
 #[derive(Args)]
 pub struct BenchRenderArgs {
@@ -41,12 +34,6 @@ pub struct BenchRenderArgs {
 /// The scene row refuses to hold more than this many bytes of per-instance
 /// coherence caches (4 bytes per slot index per instance).
 const SCENE_MEMORY_CAP: usize = 2 << 30;
-
-pub fn bench(command: &BenchCommand) -> Result<()> {
-    match command {
-        BenchCommand::Render(args) => bench_render(args),
-    }
-}
 
 /// Median milliseconds of `frames` frames of `renderer` into `target`.
 fn frame_ms(
@@ -96,7 +83,7 @@ fn lod_change_us(
     Ok(times[times.len() / 2])
 }
 
-fn bench_render(args: &BenchRenderArgs) -> Result<()> {
+pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
     let (name, model) = args.source.model()?;
     let mesh = model.mesh();
     let gpu = Gpu::new_headless()?;
@@ -192,30 +179,58 @@ fn bench_scene(
     model: &mts::MtsModel,
     args: &BenchRenderArgs,
 ) -> Result<Option<serde_json::Value>> {
+    let row = scene_row(gpu, target, config, model, args.scene, args.frames)?;
+    if let (Some(r), false) = (&row, args.json) {
+        let ms = r["ms_per_frame"].as_f64().unwrap_or(f64::NAN);
+        println!(
+            "scene: {} instances, {} visible, {} triangles, {} indices sent; \
+             first update {:.1} ms; frame {ms:.2} ms = {:.1} fps, {:.2} Mtri/s",
+            args.scene,
+            r["visible"],
+            r["triangles"],
+            r["indices_sent"],
+            r["ms_first_update"].as_f64().unwrap_or(f64::NAN),
+            1e3 / ms,
+            r["triangles_per_second"].as_f64().unwrap_or(f64::NAN) / 1e6,
+        );
+    }
+    Ok(row)
+}
+
+/// Median frame (every instance's LoD update and the draw) of `instances`
+/// copies of `model` seen by the scene's overview camera, `frames` timed
+/// frames after two warm-up ones. `None` (with a note on stderr) when the
+/// instances' coherence caches would exceed [`SCENE_MEMORY_CAP`].
+pub fn scene_row(
+    gpu: &Gpu,
+    target: &HeadlessTarget,
+    config: &RendererConfig,
+    model: &mts::MtsModel,
+    instances: usize,
+    frames: usize,
+) -> Result<Option<serde_json::Value>> {
     use mts::render::InstancedScene;
     let per_instance = 4 * Extractor::new(model).buffer().len();
-    if per_instance * args.scene > SCENE_MEMORY_CAP {
+    if per_instance * instances > SCENE_MEMORY_CAP {
         eprintln!(
-            "scene skipped: {} instances would hold {:.1} GB of coherence caches \
-             ({} bytes each); pass a smaller --scene",
-            args.scene,
-            (per_instance * args.scene) as f64 / 1e9,
-            per_instance
+            "scene skipped: {instances} instances would hold {:.1} GB of coherence caches \
+             ({per_instance} bytes each); pass a smaller --scene",
+            (per_instance * instances) as f64 / 1e9,
         );
         return Ok(None);
     }
     // The scene needs primitive restart: on GL this is a clear error.
-    let mut scene = InstancedScene::new(&gpu.device, &gpu.queue, config, model, args.scene)?;
+    let mut scene = InstancedScene::new(&gpu.device, &gpu.queue, config, model, instances)?;
     let camera = scene.overview_camera(target.aspect());
-    let height = target.size().1 as f32;
+    let (width, height) = target.size();
     let t = Instant::now();
-    let first = scene.update(&gpu.queue, &camera, height);
+    let first = scene.update(&gpu.queue, &camera, height as f32);
     let first_ms = t.elapsed().as_secs_f64() * 1e3;
-    let mut times = Vec::with_capacity(args.frames);
+    let mut times = Vec::with_capacity(frames);
     let mut stats = first;
-    for i in 0..args.frames + 2 {
+    for i in 0..frames.max(1) + 2 {
         let t = Instant::now();
-        stats = scene.update(&gpu.queue, &camera, height);
+        stats = scene.update(&gpu.queue, &camera, height as f32);
         target.render(&gpu.device, &gpu.queue, |pass| scene.draw(pass))?;
         if i >= 2 {
             times.push(t.elapsed().as_secs_f64() * 1e3);
@@ -223,23 +238,14 @@ fn bench_scene(
     }
     times.sort_by(f64::total_cmp);
     let ms = times[times.len() / 2];
-    if !args.json {
-        println!(
-            "scene: {} instances, {} visible, {} triangles, {} indices sent; \
-             first update {first_ms:.1} ms; frame {ms:.2} ms = {:.1} fps, {:.2} Mtri/s",
-            args.scene,
-            stats.visible,
-            stats.triangles,
-            stats.indices_sent,
-            1e3 / ms,
-            stats.triangles as f64 / ms / 1e3
-        );
-    }
     Ok(Some(json!({
-        "instances": args.scene,
+        "instances": instances,
+        "width": width,
+        "height": height,
         "visible": stats.visible,
         "triangles": stats.triangles,
         "indices_sent": stats.indices_sent,
+        "cpu_bytes_per_instance": per_instance,
         "ms_first_update": first_ms,
         "ms_per_frame": ms,
         "fps": 1e3 / ms,

@@ -104,15 +104,19 @@ impl Renderer {
             ex.set_lod(lod);
             strips.upload_strips(d, q, &ex)?;
             let mut immediate = Vec::with_capacity(frames);
+            let mut change = Vec::with_capacity(frames);
             for i in 0..frames + 2 {
                 let t = Instant::now();
                 ex.set_lod(if i % 2 == 0 { other } else { lod });
                 strips.update_strips(d, q, &ex)?;
+                let changed = t.elapsed().as_secs_f64() * 1e6;
                 self.target.render(d, q, |pass| strips.draw(pass))?;
                 if i >= 2 {
                     immediate.push(t.elapsed().as_secs_f64() * 1e3);
+                    change.push(changed);
                 }
             }
+            let change_us = median(change);
             // mts, one extraction per second: every strip walked again
             // and the buffer uploaded whole.
             let t = Instant::now();
@@ -145,30 +149,39 @@ impl Renderer {
                 .collect::<Result<_>>()?;
             let list_draw = median(draw);
             let per_second = |e: f64, d: f64| 1.0 + (1000.0 - e).max(0.0) / d;
-            for (method, mode, fps, indices) in [
+            let mts_indices = ex.indices_sent();
+            for (method, mode, fps, indices, draw_ms, change_us) in [
                 (
                     "mts",
                     "immediate",
                     1e3 / median(immediate),
-                    ex.indices_sent(),
+                    mts_indices,
+                    mts_draw,
+                    Some(change_us),
                 ),
                 (
                     "mts",
                     "per_second",
                     per_second(extract_ms, mts_draw),
-                    ex.indices_sent(),
+                    mts_indices,
+                    mts_draw,
+                    None,
                 ),
                 (
                     "list",
                     "immediate",
                     1e3 / median(list_immediate),
                     3 * triangles,
+                    list_draw,
+                    None,
                 ),
                 (
                     "list",
                     "per_second",
                     per_second(list_extract_ms, list_draw),
                     3 * triangles,
+                    list_draw,
+                    None,
                 ),
             ] {
                 rows.push(json!({
@@ -179,6 +192,8 @@ impl Renderer {
                     "mode": mode,
                     "indices_sent": indices,
                     "fps": fps,
+                    "draw_ms": draw_ms,
+                    "change_us": change_us,
                 }));
             }
         }
@@ -191,6 +206,25 @@ impl Renderer {
             self.measure_source(method, model, input, shares, frames, &camera, &mut rows)?;
         }
         Ok(json!({ "width": WIDTH, "height": HEIGHT, "frames": frames, "rows": rows }))
+    }
+
+    /// The scene row (see `mts bench render`) for `instances` copies of
+    /// `model`, `frames` timed frames.
+    pub fn measure_scene(
+        &self,
+        model: &MtsModel,
+        instances: usize,
+        frames: usize,
+    ) -> Result<Value> {
+        let row = super::bench_render::scene_row(
+            &self.gpu,
+            &self.target,
+            &self.config,
+            model,
+            instances,
+            frames,
+        )?;
+        Ok(row.unwrap_or(Value::Null))
     }
 
     /// Figure 6 rows of one baseline (see the module documentation).
@@ -240,7 +274,8 @@ impl Renderer {
             let draw: Vec<f64> = (0..frames)
                 .map(|_| self.draw_ms(&renderer))
                 .collect::<Result<_>>()?;
-            let per_second = 1.0 + (1000.0 - extract_ms).max(0.0) / median(draw);
+            let draw_ms = median(draw);
+            let per_second = 1.0 + (1000.0 - extract_ms).max(0.0) / draw_ms;
             let triangles = source.triangle_count(lod);
             for (mode, fps) in [
                 ("immediate", 1e3 / median(immediate.clone())),
@@ -254,6 +289,8 @@ impl Renderer {
                     "mode": mode,
                     "indices_sent": source.indices().len(),
                     "fps": fps,
+                    "draw_ms": draw_ms,
+                    "change_us": null,
                 }));
             }
         }
