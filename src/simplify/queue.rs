@@ -54,6 +54,12 @@ impl Queue {
         keys[i] = key;
     }
 
+    /// The smallest key, left in place.
+    #[inline]
+    pub(crate) fn peek(&self) -> Option<u64> {
+        self.keys.first().copied()
+    }
+
     /// Removes and returns the smallest key.
     pub(crate) fn pop(&mut self) -> Option<u64> {
         let last = self.keys.pop()?;
