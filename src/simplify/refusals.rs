@@ -3,8 +3,10 @@
 //! Refusals are rare (about one per eight contractions on the bunny) but
 //! every vertex that chooses again asks whether it has any. A `Vec` per
 //! vertex answers that from a 24-byte header per vertex; here it is one
-//! `u32` head per vertex, and the lists are linked through a shared pool
-//! whose freed entries are reused, so nothing is allocated per refusal.
+//! bit per vertex (a 1M-triangle mesh's bits fit in 64 KB, so the question
+//! stays in cache), a `u32` head per vertex, and the lists are linked
+//! through a shared pool whose freed entries are reused, so nothing is
+//! allocated per refusal.
 
 /// End of a list.
 const NIL: u32 = u32::MAX;
@@ -12,6 +14,8 @@ const NIL: u32 = u32::MAX;
 /// For each vertex, an unordered set of refused targets (a target may be
 /// refused twice; it is then listed twice and counted twice).
 pub(crate) struct Refusals {
+    /// Bit `v % 64` of word `v / 64` is set when `v`'s list is not empty.
+    any: Vec<u64>,
     /// First entry of each vertex's list in `pool` ([`NIL`] when empty).
     head: Vec<u32>,
     /// `(target, next entry)`; free entries are linked from `free`.
@@ -25,6 +29,7 @@ impl Refusals {
     /// No refusals for `vertex_count` vertices.
     pub(crate) fn new(vertex_count: usize) -> Refusals {
         Refusals {
+            any: vec![0; vertex_count.div_ceil(64)],
             head: vec![NIL; vertex_count],
             pool: Vec::new(),
             free: NIL,
@@ -35,6 +40,9 @@ impl Refusals {
     /// Adds a vertex without refusals.
     pub(crate) fn push_vertex(&mut self) {
         self.head.push(NIL);
+        if self.any.len() * 64 < self.head.len() {
+            self.any.push(0);
+        }
     }
 
     /// Refusals of all vertices.
@@ -45,7 +53,7 @@ impl Refusals {
     /// Whether `v` has no refusal.
     #[inline]
     pub(crate) fn is_empty(&self, v: u32) -> bool {
-        self.head[v as usize] == NIL
+        self.any[v as usize / 64] & (1 << (v % 64)) == 0
     }
 
     /// Whether `v`'s contraction onto `target` was refused.
@@ -75,12 +83,17 @@ impl Refusals {
             e
         };
         self.head[v as usize] = e;
+        self.any[v as usize / 64] |= 1 << (v % 64);
         self.count += 1;
     }
 
     /// Forgets `v`'s refusals. O(their number).
     #[inline]
     pub(crate) fn forget(&mut self, v: u32) {
+        if self.is_empty(v) {
+            return;
+        }
+        self.any[v as usize / 64] &= !(1 << (v % 64));
         let mut e = std::mem::replace(&mut self.head[v as usize], NIL);
         while e != NIL {
             let next = self.pool[e as usize].1;
