@@ -61,7 +61,7 @@ use glam::{DVec3, Vec3};
 /// Runs until no valid pair remains (or until
 /// [`SimplifyOptions::stop_at_triangles`]), and says where and why it
 /// stopped in [`Simplification::stop`]. Cost: O((V + T) log T) for
-/// bounded valences; memory under 200 bytes per triangle at peak (189 for
+/// bounded valences; memory under 200 bytes per triangle at peak (177 for
 /// the whole `mts simplify` process on a 1M-triangle icosphere).
 ///
 /// # Panics
@@ -148,7 +148,8 @@ struct Contractor {
     refusals: Refusals,
     /// Scratch vertex list (neighbours of a survivor).
     ring: Vec<u32>,
-    /// Scratch vertex list of [`Contractor::best`] in optimal mode.
+    /// Scratch vertex list (a vertex's partners, in [`Contractor::best`]
+    /// in optimal mode and for the survivor in [`Contractor::contract`]).
     around: Vec<u32>,
     /// Output.
     steps: Vec<Collapse>,

@@ -10,8 +10,9 @@
 //! A list that outgrows its block moves to the end of `items` (or into the
 //! merged list's block when that is larger); the blocks left behind are
 //! garbage, and `items` is compacted once the garbage outweighs the live
-//! blocks, so its length stays within twice the live capacity plus the
-//! input's `3T` (amortised O(1) per item moved).
+//! blocks, so it stays within about twice the live capacity (amortised
+//! O(1) per item moved). Relocated blocks get half their length again as
+//! room, so a growing list moves O(log) times.
 
 /// Where a vertex's list lies in [`Fans::items`].
 #[derive(Clone, Copy, Default)]

@@ -3,8 +3,10 @@
 //! [`simplify`] runs Garland and Heckbert's greedy pair contraction
 //! (`contract.rs`) until no valid pair remains and records every step in
 //! [`Collapses`], which answers representatives, triangle counts and the
-//! naive replay at any LoD. `quadric.rs` holds the error quadrics and
-//! `pairs.rs` the candidate pairs.
+//! naive replay at any LoD. `quadric.rs` holds the error quadrics,
+//! `pairs.rs` the candidate pairs, and `queue.rs`, `fans.rs` and
+//! `refusals.rs` the loop's flat structures: the priority queue, the
+//! triangles around each vertex and the targets a guard refused.
 
 mod collapses;
 mod contract;
