@@ -44,9 +44,12 @@
 //!   triangles leaves only along such an edge.
 
 use super::collapses::{Collapse, Collapses};
-use super::pairs::{vertex_triangles, virtual_pairs};
+use super::fans::Fans;
+use super::pairs::virtual_pairs;
+use super::prefetch;
 use super::quadric::Quadric;
 use super::queue::{cost_bits, key, Queue};
+use super::refusals::Refusals;
 use super::{Placement, Simplification, SimplifyOptions, Stop, StopReason};
 use crate::mesh::Mesh;
 #[cfg(doc)]
@@ -58,7 +61,7 @@ use glam::{DVec3, Vec3};
 /// Runs until no valid pair remains (or until
 /// [`SimplifyOptions::stop_at_triangles`]), and says where and why it
 /// stopped in [`Simplification::stop`]. Cost: O((V + T) log T) for
-/// bounded valences; memory under 200 bytes per triangle at peak (189 for
+/// bounded valences; memory under 200 bytes per triangle at peak (177 for
 /// the whole `mts simplify` process on a 1M-triangle icosphere).
 ///
 /// # Panics
@@ -116,8 +119,8 @@ struct Contractor {
     /// triangle, zero for a zero-area one; see [`Contractor::input_normal`].
     normals0: Vec<Vec3>,
     /// Triangles around each vertex; may hold dead ones until the vertex is
-    /// next contracted.
-    vertex_tris: Vec<Vec<u32>>,
+    /// next contracted or chooses again.
+    fans: Fans,
     /// Virtual partners of each vertex (empty unless enabled).
     partners: Vec<Vec<u32>>,
     removed: Vec<bool>,
@@ -141,11 +144,13 @@ struct Contractor {
     /// ([`NO_KEY`] when none may be).
     floor: Vec<u32>,
     /// Targets a guard refused for each vertex since its neighbourhood last
-    /// changed; `blocked_count` counts them all.
-    blocked: Vec<Vec<u32>>,
-    blocked_count: usize,
+    /// changed.
+    refusals: Refusals,
     /// Scratch vertex list (neighbours of a survivor).
     ring: Vec<u32>,
+    /// Scratch vertex list (a vertex's partners, in [`Contractor::best`]
+    /// in optimal mode and for the survivor in [`Contractor::contract`]).
+    around: Vec<u32>,
     /// Output.
     steps: Vec<Collapse>,
     triangle_counts: Vec<u32>,
@@ -189,9 +194,9 @@ impl Contractor {
             };
             normals0.push(normal);
         }
-        let vertex_tris = vertex_triangles(n, &tris);
+        let fans = Fans::new(n, &tris);
         if options.boundary_weight > 0.0 {
-            let borders = border_slots(&tris, &vertex_tris);
+            let borders = border_slots(&tris, &fans);
             for (t, tri) in tris.iter().enumerate() {
                 for slot in 0..3 {
                     if borders[t] & (1 << slot) == 0 {
@@ -230,7 +235,7 @@ impl Contractor {
         let diagonal = f64::from(mesh.diagonal()).max(f64::MIN_POSITIVE);
         let mut partners = Vec::new();
         if let Some(d) = options.pair_distance {
-            let pairs = virtual_pairs(&mesh.positions, &vertex_tris, &tris, d * mesh.diagonal());
+            let pairs = virtual_pairs(&mesh.positions, &fans, &tris, d * mesh.diagonal());
             if !pairs.is_empty() {
                 partners = vec![Vec::new(); n];
                 for (a, b) in pairs {
@@ -248,7 +253,7 @@ impl Contractor {
             tris,
             normals0,
             appended_pos: Vec::new(),
-            vertex_tris,
+            fans,
             partners,
             removed: vec![false; n],
             allow_folds: false,
@@ -258,9 +263,9 @@ impl Contractor {
             heap: Queue::with_capacity(2 * n),
             queued: vec![(f32::NAN, NONE); n],
             floor: vec![NO_KEY; n],
-            blocked: vec![Vec::new(); n],
-            blocked_count: 0,
+            refusals: Refusals::new(n),
             ring: Vec::new(),
+            around: Vec::new(),
             steps: Vec::new(),
             triangle_counts: vec![triangles_now],
             appended: Vec::new(),
@@ -277,7 +282,7 @@ impl Contractor {
     /// Asks for the triangles around `v` ahead of the loops over them.
     #[inline]
     fn prefetch_ring(&self, v: u32) {
-        for &t in &self.vertex_tris[v as usize] {
+        for &t in self.fans.get(v) {
             prefetch(&self.tris[t as usize]);
         }
     }
@@ -298,29 +303,28 @@ impl Contractor {
         self.normals0[t as usize].as_dvec3().normalize_or_zero()
     }
 
-    /// Calls `f` once for every current neighbour or virtual partner of `v`.
-    fn for_each_partner(&mut self, v: u32, mut f: impl FnMut(&mut Contractor, u32)) {
+    /// Appends every current neighbour and virtual partner of `v` to `out`,
+    /// once each, in fan order.
+    fn partners_into(&mut self, v: u32, out: &mut Vec<u32>) {
         let epoch = self.next_epoch();
-        let list = std::mem::take(&mut self.vertex_tris[v as usize]);
-        for &t in &list {
-            if self.tris[t as usize][0] == DEAD {
+        for &t in self.fans.get(v) {
+            let tri = self.tris[t as usize];
+            if tri[0] == DEAD {
                 continue;
             }
-            for w in self.tris[t as usize] {
+            for w in tri {
                 if w != v && self.mark[w as usize] != epoch {
                     self.mark[w as usize] = epoch;
-                    f(self, w);
+                    out.push(w);
                 }
             }
         }
-        self.vertex_tris[v as usize] = list;
-        // `f` never changes partner lists, so index instead of copying.
-        let partner_count = self.partners.get(v as usize).map_or(0, Vec::len);
-        for i in 0..partner_count {
-            let w = self.partners[v as usize][i];
-            if !self.removed[w as usize] && self.mark[w as usize] != epoch {
-                self.mark[w as usize] = epoch;
-                f(self, w);
+        if let Some(partners) = self.partners.get(v as usize) {
+            for &w in partners {
+                if !self.removed[w as usize] && self.mark[w as usize] != epoch {
+                    self.mark[w as usize] = epoch;
+                    out.push(w);
+                }
             }
         }
     }
@@ -341,17 +345,19 @@ impl Contractor {
             return self.best_endpoint(v);
         }
         let mut best: Option<(f64, u32)> = None;
-        let blocked = std::mem::take(&mut self.blocked[v as usize]);
-        self.for_each_partner(v, |c, w| {
-            if blocked.contains(&w) {
-                return;
+        let mut around = std::mem::take(&mut self.around);
+        around.clear();
+        self.partners_into(v, &mut around);
+        for &w in &around {
+            if self.refusals.contains(v, w) {
+                continue;
             }
-            let cost = c.pair_cost(v, w);
+            let cost = self.pair_cost(v, w);
             if best.is_none_or(|(bc, bw)| cost < bc || (cost == bc && w < bw)) {
                 best = Some((cost, w));
             }
-        });
-        self.blocked[v as usize] = blocked;
+        }
+        self.around = around;
         best
     }
 
@@ -368,10 +374,10 @@ impl Contractor {
         /// larger ones cost every occurrence.
         const FAN: usize = 24;
         let q = &self.quadrics[v as usize];
-        let blocked = &self.blocked[v as usize];
+        let refused = !self.refusals.is_empty(v);
         let mut best: Option<(f64, u32)> = None;
         let mut consider = |w: u32| {
-            if blocked.contains(&w) {
+            if refused && self.refusals.contains(v, w) {
                 return;
             }
             let cost = q.mean_error(self.p(w));
@@ -379,7 +385,7 @@ impl Contractor {
                 best = Some((cost, w));
             }
         };
-        let around = &self.vertex_tris[v as usize];
+        let around = self.fans.get(v);
         if around.len() <= FAN {
             let mut next = [0u32; FAN];
             let mut prev = [0u32; FAN];
@@ -463,9 +469,7 @@ impl Contractor {
     /// (the old entry then goes stale).
     fn refresh(&mut self, v: u32) {
         // Drop the triangles that died around `v` while it stayed.
-        let mut list = std::mem::take(&mut self.vertex_tris[v as usize]);
-        list.retain(|&t| self.tris[t as usize][0] != DEAD);
-        self.vertex_tris[v as usize] = list;
+        self.fans.retain(v, |t| self.tris[t as usize][0] != DEAD);
         let new = self
             .best(v)
             .map_or((f32::INFINITY, NONE), |(c, w)| (c as f32, w));
@@ -493,8 +497,7 @@ impl Contractor {
     /// Forgets what the guards refused `v`, so that it chooses among all
     /// its targets again.
     fn forget_refusals(&mut self, v: u32) {
-        self.blocked_count -= self.blocked[v as usize].len();
-        self.blocked[v as usize].clear();
+        self.refusals.forget(v);
     }
 
     /// Queues `v → w` if it is cheaper than `v`'s queued contraction.
@@ -556,7 +559,7 @@ impl Contractor {
                 // (a guard looks at more than the two vertices' own
                 // neighbourhoods); try everything again unless the round
                 // changed nothing.
-                if self.steps.len() == round_start || self.blocked_count == 0 {
+                if self.steps.len() == round_start || self.refusals.count() == 0 {
                     if self.allow_folds {
                         self.stop = Some(self.stop_record(StopReason::NoValidPair, round));
                         return;
@@ -570,6 +573,13 @@ impl Contractor {
                 continue;
             };
             let a = k as u32;
+            // The next key is most often the next contraction: ask for its
+            // vertex's state while this one is handled.
+            if let Some(next) = self.heap.peek() {
+                let v = next as u32;
+                prefetch(&self.queued[v as usize]);
+                self.fans.prefetch_span(v);
+            }
             // Other keys of `a` may remain, but none lower.
             self.floor[a as usize] = NO_KEY;
             let (cost, b) = self.queued[a as usize];
@@ -585,6 +595,9 @@ impl Contractor {
                 }
                 continue;
             }
+            self.quadrics[a as usize].prefetch();
+            self.quadrics[b as usize].prefetch();
+            self.fans.prefetch_span(b);
             if self.removed[b as usize] {
                 // The target went away without `a` being next to its
                 // survivor (their shared triangles died with it).
@@ -600,8 +613,7 @@ impl Contractor {
                         Reject::Flip => round.flip += 1,
                         Reject::Topology => round.topology += 1,
                     }
-                    self.blocked[a as usize].push(b);
-                    self.blocked_count += 1;
+                    self.refusals.add(a, b);
                     self.refresh(a);
                 }
             }
@@ -634,7 +646,10 @@ impl Contractor {
     /// The guards of the module docs for contracting `a` into `b` placed at
     /// `target`. Allocation-free; O(valence(a) · valence(b)) at worst.
     fn check(&mut self, a: u32, b: u32, target: DVec3) -> Result<(), Reject> {
-        self.prefetch_ring(a);
+        for &t in self.fans.get(a) {
+            prefetch(&self.tris[t as usize]);
+            prefetch(&self.normals0[t as usize]);
+        }
         self.prefetch_ring(b);
         // Topology rule, after meshoptimizer's vertex kinds: an interior
         // vertex goes anywhere; a vertex on a border (an edge with other
@@ -655,17 +670,21 @@ impl Contractor {
         }
         let epoch = self.next_epoch();
         let apex = epoch + 1;
-        // Mark a's neighbours.
-        for &t in &self.vertex_tris[a as usize] {
+        // Mark a's neighbours (and ask for their positions, which the flip
+        // test reads).
+        for &t in self.fans.get(a) {
             if self.tris[t as usize][0] != DEAD {
                 for w in self.tris[t as usize] {
                     self.mark[w as usize] = epoch;
+                    if let Some(p) = self.pos.get(w as usize) {
+                        prefetch(p);
+                    }
                 }
             }
         }
         // Apexes of the triangles on edge (a, b): the only allowed common
         // neighbours.
-        for &t in &self.vertex_tris[b as usize] {
+        for &t in self.fans.get(b) {
             let tri = self.tris[t as usize];
             if self.tris[t as usize][0] != DEAD && tri.contains(&a) {
                 for w in tri {
@@ -675,7 +694,7 @@ impl Contractor {
                 }
             }
         }
-        for &t in &self.vertex_tris[b as usize] {
+        for &t in self.fans.get(b) {
             let tri = self.tris[t as usize];
             if self.tris[t as usize][0] != DEAD
                 && !tri.contains(&a)
@@ -691,7 +710,7 @@ impl Contractor {
         let mut fan = std::mem::take(&mut self.fan);
         fan.clear();
         let mut verdict = Ok(());
-        for &t in &self.vertex_tris[a as usize] {
+        for &t in self.fans.get(a) {
             let tri = self.tris[t as usize];
             if self.tris[t as usize][0] == DEAD || tri.contains(&b) {
                 continue;
@@ -713,7 +732,7 @@ impl Contractor {
         self.fan = fan;
         verdict?;
         if self.placement == Placement::Optimal {
-            for &t in &self.vertex_tris[b as usize] {
+            for &t in self.fans.get(b) {
                 let tri = self.tris[t as usize];
                 if self.tris[t as usize][0] != DEAD && !tri.contains(&a) && self.flips(t, b, target)
                 {
@@ -729,7 +748,7 @@ impl Contractor {
     fn border_and_count(&mut self, v: u32, w: u32) -> (bool, usize) {
         let mut counts = std::mem::take(&mut self.scratch);
         counts.clear();
-        for &t in &self.vertex_tris[v as usize] {
+        for &t in self.fans.get(v) {
             if self.tris[t as usize][0] == DEAD {
                 continue;
             }
@@ -753,7 +772,7 @@ impl Contractor {
     /// replaced by `b`.
     fn has_triangle_on(&self, b: u32, tri: [u32; 3], a: u32) -> bool {
         let want = tri.map(|w| if w == a { b } else { w });
-        self.vertex_tris[b as usize].iter().any(|&u| {
+        self.fans.get(b).iter().any(|&u| {
             self.tris[u as usize][0] != DEAD
                 && want.iter().all(|w| self.tris[u as usize].contains(w))
         })
@@ -808,7 +827,7 @@ impl Contractor {
         let mut ring = std::mem::take(&mut self.ring);
         ring.clear();
         ring.push(b);
-        self.for_each_partner(a, |_, w| ring.push(w));
+        self.partners_into(a, &mut ring);
         let q = self.quadrics[a as usize] + self.quadrics[b as usize];
         let survivor = match self.placement {
             Placement::Endpoint => b,
@@ -816,12 +835,12 @@ impl Contractor {
                 let c = self.removed.len() as u32;
                 self.appended_pos.push(target);
                 self.quadrics.push(Quadric::default());
-                self.vertex_tris.push(Vec::new());
+                self.fans.push_vertex();
                 self.removed.push(false);
                 self.mark.push(0);
                 self.queued.push((f32::NAN, NONE));
                 self.floor.push(NO_KEY);
-                self.blocked.push(Vec::new());
+                self.refusals.push_vertex();
                 if !self.partners.is_empty() {
                     self.partners.push(Vec::new());
                 }
@@ -830,15 +849,15 @@ impl Contractor {
             }
         };
         self.quadrics[survivor as usize] = q;
-        // b's list is reused in place: its live triangles without `a`,
-        // then `a`'s survivors (which never contain `b`).
-        let mut merged = std::mem::take(&mut self.vertex_tris[b as usize]);
+        // The survivor's list: b's live triangles without `a`, then `a`'s
+        // live ones (which never contain `b`), in b's block when it has room.
         let mut dead = 0u32;
-        merged.retain(|&t| {
-            if self.tris[t as usize][0] == DEAD {
+        let tris = &mut self.tris;
+        self.fans.retain(b, |t| {
+            let tri = &mut tris[t as usize];
+            if tri[0] == DEAD {
                 return false;
             }
-            let tri = &mut self.tris[t as usize];
             if tri.contains(&a) {
                 *tri = [DEAD; 3];
                 dead += 1;
@@ -851,22 +870,22 @@ impl Contractor {
             }
             true
         });
-        let from_a = std::mem::take(&mut self.vertex_tris[a as usize]);
-        for &t in &from_a {
-            if self.tris[t as usize][0] == DEAD {
-                continue;
+        if survivor != b {
+            self.fans.move_into(b, survivor, |_| true);
+            self.removed[b as usize] = true;
+        }
+        self.fans.move_into(a, survivor, |t| {
+            let tri = &mut tris[t as usize];
+            if tri[0] == DEAD {
+                return false;
             }
-            for w in self.tris[t as usize].iter_mut() {
+            for w in tri.iter_mut() {
                 if *w == a {
                     *w = survivor;
                 }
             }
-            merged.push(t);
-        }
-        if survivor != b {
-            self.removed[b as usize] = true;
-        }
-        self.vertex_tris[survivor as usize] = merged;
+            true
+        });
         if !self.partners.is_empty() {
             let mut list = std::mem::take(&mut self.partners[a as usize]);
             list.append(&mut self.partners[b as usize]);
@@ -891,7 +910,6 @@ impl Contractor {
         for gone in [a, b] {
             if gone != survivor {
                 self.forget_refusals(gone);
-                self.blocked[gone as usize] = Vec::new();
             }
         }
         self.triangles_now -= dead;
@@ -911,15 +929,20 @@ impl Contractor {
             ring.push(survivor);
         }
         let everyone = survivor != b;
-        self.for_each_partner(survivor, |c, w| {
-            if everyone || !c.blocked[w as usize].is_empty() {
-                ring.push(w);
-            }
-        });
+        let mut around = std::mem::take(&mut self.around);
+        around.clear();
+        self.partners_into(survivor, &mut around);
+        ring.extend(
+            around
+                .iter()
+                .copied()
+                .filter(|&w| everyone || !self.refusals.is_empty(w)),
+        );
+        self.around = around;
         for &v in &ring {
             prefetch(&self.queued[v as usize]);
-            prefetch(&self.vertex_tris[v as usize]);
-            prefetch(&self.quadrics[v as usize]);
+            prefetch(self.fans.get(v));
+            self.quadrics[v as usize].prefetch();
         }
         for (i, &v) in ring.iter().enumerate() {
             if let Some(&next) = ring.get(i + 1) {
@@ -933,7 +956,7 @@ impl Contractor {
                 || everyone
                 || queued_target == a
                 || queued_target == NONE
-                || !self.blocked[v as usize].is_empty();
+                || !self.refusals.is_empty(v);
             if full {
                 self.forget_refusals(v);
                 self.refresh(v);
@@ -1030,11 +1053,11 @@ fn folds(fan: &[Turn]) -> bool {
 /// For each triangle, bit `slot` set when [`is_border`] holds for that
 /// edge slot. Works vertex by vertex on a local copy of the corners (the
 /// triangles around `a` read once, not once per slot).
-fn border_slots(tris: &[[u32; 3]], vertex_tris: &[Vec<u32>]) -> Vec<u8> {
+fn border_slots(tris: &[[u32; 3]], fans: &Fans) -> Vec<u8> {
     const LOCAL: usize = 32;
     let mut out = vec![0u8; tris.len()];
-    for (a, around) in vertex_tris.iter().enumerate() {
-        let a = a as u32;
+    for a in 0..fans.vertex_count() as u32 {
+        let around = fans.get(a);
         if around.len() > LOCAL {
             for &t in around {
                 let tri = tris[t as usize];
@@ -1086,20 +1109,6 @@ fn is_border(tris: &[[u32; 3]], around_a: &[u32], t: u32, a: u32, b: u32) -> boo
     rank >= opposite
 }
 
-/// Hints the cache to load `x` (the loops here wait on memory, not on
-/// arithmetic, and their next loads are known early). No effect off x86-64.
-#[inline(always)]
-fn prefetch<T>(x: &T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch of a valid reference never faults or writes.
-    unsafe {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(x).cast::<i8>());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
-}
-
 /// Rejections counted over one round of the queue.
 #[derive(Default, Clone, Copy)]
 struct RoundStats {
@@ -1131,13 +1140,13 @@ mod tests {
         mesh.triangles.push([y, x, extra + 1]);
         mesh.triangles.push([x, z, extra]);
         let adjacency = TriangleAdjacency::new(&mesh);
-        let around = vertex_triangles(mesh.positions.len(), &mesh.triangles);
+        let around = Fans::new(mesh.positions.len(), &mesh.triangles);
         let slots = border_slots(&mesh.triangles, &around);
         let mut borders = 0;
         for (t, tri) in mesh.triangles.iter().enumerate() {
             for slot in 0..3 {
                 let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
-                let border = is_border(&mesh.triangles, &around[a as usize], t as u32, a, b);
+                let border = is_border(&mesh.triangles, around.get(a), t as u32, a, b);
                 assert_eq!(border, adjacency.neighbours[t][slot] == NO_NEIGHBOUR);
                 assert_eq!(border, slots[t] & (1 << slot) != 0);
                 borders += usize::from(border);

@@ -3,14 +3,18 @@
 //! [`simplify`] runs Garland and Heckbert's greedy pair contraction
 //! (`contract.rs`) until no valid pair remains and records every step in
 //! [`Collapses`], which answers representatives, triangle counts and the
-//! naive replay at any LoD. `quadric.rs` holds the error quadrics and
-//! `pairs.rs` the candidate pairs.
+//! naive replay at any LoD. `quadric.rs` holds the error quadrics,
+//! `pairs.rs` the candidate pairs, and `queue.rs`, `fans.rs` and
+//! `refusals.rs` the loop's flat structures: the priority queue, the
+//! triangles around each vertex and the targets a guard refused.
 
 mod collapses;
 mod contract;
+mod fans;
 mod pairs;
 pub mod quadric;
 mod queue;
+mod refusals;
 
 pub use collapses::{Collapse, Collapses};
 pub use contract::simplify;
@@ -119,4 +123,18 @@ pub struct Simplification {
     pub collapses: Collapses,
     /// Where and why it ended.
     pub stop: Stop,
+}
+
+/// Hints the cache to load `x` (the loops here wait on memory, not on
+/// arithmetic, and their next loads are known early). No effect off x86-64.
+#[inline(always)]
+pub(crate) fn prefetch<T: ?Sized>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch of a valid reference never faults or writes.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(x).cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }

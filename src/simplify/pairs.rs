@@ -2,6 +2,7 @@
 //! the mesh edges, and optionally "virtual" pairs of vertices closer than a
 //! threshold that share no edge.
 
+use super::fans::Fans;
 use glam::Vec3;
 use std::collections::HashMap;
 
@@ -9,33 +10,13 @@ use std::collections::HashMap;
 /// candidate count when the threshold is large against the sampling.
 pub(crate) const MAX_VIRTUAL_PER_VERTEX: usize = 8;
 
-/// For each vertex, the triangles that use it. O(V + T), exact capacities.
-pub(crate) fn vertex_triangles(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
-    let mut degree = vec![0u32; vertex_count];
-    for t in triangles {
-        for &v in t {
-            degree[v as usize] += 1;
-        }
-    }
-    let mut out: Vec<Vec<u32>> = degree
-        .iter()
-        .map(|&d| Vec::with_capacity(d as usize))
-        .collect();
-    for (i, t) in triangles.iter().enumerate() {
-        for &v in t {
-            out[v as usize].push(i as u32);
-        }
-    }
-    out
-}
-
 /// Pairs `(a, b)`, `a < b`, of vertices closer than `distance` that share
 /// no triangle, at most [`MAX_VIRTUAL_PER_VERTEX`] (the closest) per vertex
 /// `a`. A uniform grid with cells of side `distance` finds them in
 /// O(V + pairs) for well-spread points.
 pub(crate) fn virtual_pairs(
     positions: &[Vec3],
-    vertex_tris: &[Vec<u32>],
+    fans: &Fans,
     triangles: &[[u32; 3]],
     distance: f32,
 ) -> Vec<(u32, u32)> {
@@ -48,7 +29,7 @@ pub(crate) fn virtual_pairs(
         grid.entry(cell(p)).or_default().push(i as u32);
     }
     let shares_triangle = |a: u32, b: u32| {
-        vertex_tris[a as usize]
+        fans.get(a)
             .iter()
             .any(|&t| triangles[t as usize].contains(&b))
     };
@@ -101,7 +82,7 @@ mod tests {
             Vec3::new(0.0, 1.0, 0.1),
         ];
         let triangles = vec![[0, 1, 2], [3, 4, 5]];
-        let vt = vertex_triangles(6, &triangles);
+        let vt = Fans::new(6, &triangles);
         let mut pairs = virtual_pairs(&positions, &vt, &triangles, 0.2);
         pairs.sort_unstable();
         assert_eq!(pairs, vec![(0, 3), (1, 4), (2, 5)]);

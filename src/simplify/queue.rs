@@ -6,6 +6,13 @@
 //! 16-byte entries would. The target is not stored: an entry is current
 //! when its cost equals the vertex's queued cost (see
 //! `Contractor::queued`), and the target is read there.
+//!
+//! A pop on a large queue waits on one cache miss per level (its children
+//! decide where to go next). The 16 grandchildren of a node are contiguous
+//! and their place needs no load, so each level asks for them before it
+//! compares its children, and the next level's miss overlaps this one's
+//! (1M-triangle icosphere: pops were 18% of the sequence's time, nearly
+//! all of it on the load of the first child).
 
 /// Packs `cost` and `vertex` so that `u64` order is `f32::total_cmp` on
 /// the cost, then the vertex index.
@@ -54,6 +61,12 @@ impl Queue {
         keys[i] = key;
     }
 
+    /// The smallest key, left in place.
+    #[inline]
+    pub(crate) fn peek(&self) -> Option<u64> {
+        self.keys.first().copied()
+    }
+
     /// Removes and returns the smallest key.
     pub(crate) fn pop(&mut self) -> Option<u64> {
         let last = self.keys.pop()?;
@@ -68,6 +81,14 @@ impl Queue {
             let first = 4 * i + 1;
             if first >= n {
                 break;
+            }
+            let grandchildren = 4 * first + 1;
+            if grandchildren < n {
+                // 128 bytes: three lines at most, reached from 64 bytes apart.
+                let last = (grandchildren + 15).min(n - 1);
+                super::prefetch(&keys[grandchildren]);
+                super::prefetch(&keys[(grandchildren + 8).min(last)]);
+                super::prefetch(&keys[last]);
             }
             let (mut m, mut mk) = (first, keys[first]);
             let end = (first + 4).min(n);
