@@ -10,6 +10,9 @@
 use super::path::{pivot, slot_to};
 use crate::mesh::{TriangleAdjacency, NO_NEIGHBOUR};
 
+/// `free_deg` of a taken triangle.
+const TAKEN: u8 = u8::MAX;
+
 /// Which triangles are taken, and a bucket queue of the free ones by their
 /// number of free neighbours (0–3). Entries are lazy: a triangle is pushed
 /// again when its count drops, and stale entries are skipped when popped,
@@ -18,7 +21,9 @@ use crate::mesh::{TriangleAdjacency, NO_NEIGHBOUR};
 pub(super) struct Walk<'a> {
     pub(super) tris: &'a [[u32; 3]],
     pub(super) adj: &'a TriangleAdjacency,
-    pub(super) used: Vec<bool>,
+    /// Free neighbours of each free triangle, or [`TAKEN`]: one array, so
+    /// that testing a candidate and reading its count touch one cache line
+    /// (the walk is bound by cache misses on large meshes).
     free_deg: Vec<u8>,
     buckets: [Vec<u32>; 4],
     pub(super) swap_penalty: f32,
@@ -39,7 +44,6 @@ impl<'a> Walk<'a> {
         Walk {
             tris,
             adj,
-            used: vec![false; tris.len()],
             free_deg,
             buckets,
             swap_penalty: 0.5,
@@ -47,13 +51,13 @@ impl<'a> Walk<'a> {
     }
 
     pub(super) fn is_free(&self, t: u32) -> bool {
-        t != NO_NEIGHBOUR && !self.used[t as usize]
+        t != NO_NEIGHBOUR && self.free_deg[t as usize] != TAKEN
     }
 
     /// Marks `t` as taken and updates its free neighbours' counts.
     pub(super) fn take(&mut self, t: u32) {
-        debug_assert!(!self.used[t as usize], "triangle taken twice");
-        self.used[t as usize] = true;
+        debug_assert_ne!(self.free_deg[t as usize], TAKEN, "triangle taken twice");
+        self.free_deg[t as usize] = TAKEN;
         for &n in &self.adj.neighbours[t as usize] {
             if self.is_free(n) {
                 let d = &mut self.free_deg[n as usize];
@@ -68,7 +72,7 @@ impl<'a> Walk<'a> {
     fn pop_start(&mut self) -> Option<u32> {
         for d in 0..4 {
             while let Some(t) = self.buckets[d].pop() {
-                if !self.used[t as usize] && self.free_deg[t as usize] as usize == d {
+                if self.free_deg[t as usize] as usize == d {
                     return Some(t);
                 }
             }
@@ -84,25 +88,32 @@ impl<'a> Walk<'a> {
     pub(super) fn grow_back(&mut self, path: &mut Vec<u32>) {
         let n = path.len();
         let mut cur = path[n - 1];
-        // Entry slot of `cur` and the pivot at the previous triangle, carried
-        // from step to step.
+        // Entry slot of `cur`, carried from step to step.
         let mut entry = (n >= 2).then(|| slot_to(self.adj, cur, path[n - 2]));
-        let mut last_pivot = (n >= 3).then(|| {
+        // Where the pivot at the previous triangle lies in `cur`: the start
+        // or the end of the entry edge (slot `entry` or `entry + 1`), or
+        // neither. A swap is needed when the pivot at `cur` is that vertex.
+        // Positions instead of vertex ids keep the loop off the triangle
+        // array (one cache miss fewer per step; vertices and positions
+        // correspond one to one in a non-degenerate triangle).
+        let mut pivot_at = if n >= 3 {
             let prev = path[n - 2];
             let a = slot_to(self.adj, prev, path[n - 3]);
             let b = slot_to(self.adj, prev, cur);
-            pivot(&self.tris[prev as usize], a, b)
-        });
+            let p = pivot(&self.tris[prev as usize], a, b);
+            self.tris[cur as usize].iter().position(|&v| v == p)
+        } else {
+            None
+        };
         loop {
-            let t = &self.tris[cur as usize];
             let ns = &self.adj.neighbours[cur as usize];
             let mut best: Option<(f32, usize)> = None;
             for (s, &cand) in ns.iter().enumerate() {
                 if Some(s) == entry || !self.is_free(cand) {
                     continue;
                 }
-                let swap = match (entry, last_pivot) {
-                    (Some(e), Some(p)) => pivot(t, e, s) == p,
+                let swap = match (entry, pivot_at) {
+                    (Some(e), Some(p)) => pivot_slot(e, s) == p,
                     _ => false,
                 };
                 let score = f32::from(self.free_deg[cand as usize])
@@ -113,12 +124,31 @@ impl<'a> Walk<'a> {
             }
             let Some((_, s)) = best else { return };
             let next = ns[s];
-            last_pivot = entry.map(|e| pivot(t, e, s));
-            entry = Some(self.adj.mate(cur, s));
+            let next_entry = self.adj.mate(cur, s);
+            // Exit edge `s` is `next`'s edge `next_entry` reversed: its
+            // start is at `next_entry + 1`, its end at `next_entry`.
+            pivot_at = entry.map(|e| {
+                if pivot_slot(e, s) == s {
+                    (next_entry + 1) % 3
+                } else {
+                    next_entry
+                }
+            });
+            entry = Some(next_entry);
             self.take(next);
             path.push(next);
             cur = next;
         }
+    }
+}
+
+/// The position in a triangle of the vertex shared by its edge slots `a`
+/// and `b` (distinct): [`pivot`] without reading the vertices.
+fn pivot_slot(a: usize, b: usize) -> usize {
+    if b == (a + 1) % 3 {
+        b
+    } else {
+        a
     }
 }
 
@@ -133,5 +163,20 @@ pub(super) fn strip_rest(walk: &mut Walk<'_>, paths: &mut Vec<Vec<u32>>) {
         path.reverse();
         walk.grow_back(&mut path);
         paths.push(path);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pivot_slot_is_the_position_of_the_pivot() {
+        let t = [7, 8, 9];
+        for a in 0..3 {
+            for b in (0..3).filter(|&b| b != a) {
+                assert_eq!(t[pivot_slot(a, b)], pivot(&t, a, b));
+            }
+        }
     }
 }

@@ -30,8 +30,18 @@ pub(super) fn pivot(t: &[u32; 3], a: usize, b: usize) -> u32 {
 /// A slot of `t` whose neighbour is `u` (the first when they share more
 /// than one edge: any shared edge gives a valid run).
 pub(super) fn slot_to(adj: &TriangleAdjacency, t: u32, u: u32) -> usize {
-    adj.slot_of(t, u)
-        .expect("path triangles are not adjacent (internal error)")
+    // Selects instead of a search loop: the slot is unpredictable, the
+    // check below is not.
+    let ns = &adj.neighbours[t as usize];
+    let s = if ns[0] == u {
+        0
+    } else if ns[1] == u {
+        1
+    } else {
+        2
+    };
+    assert_eq!(ns[s], u, "path triangles are not adjacent (internal error)");
+    s
 }
 
 /// Whether starting the run at `path[0]` costs a swap at `path[1]`.
@@ -66,17 +76,22 @@ pub(super) fn encode(path: &[u32], tris: &[[u32; 3]], adj: &TriangleAdjacency, o
     }
     let e0 = slot_to(adj, path[0], path[1]);
     out.extend_from_slice(&[t0[(e0 + 2) % 3], t0[e0], t0[(e0 + 1) % 3]]);
+    // Written without data-dependent branches where it can be (a search
+    // for the apex or a test of two edge ends mispredicts about once per
+    // triangle): the apex is what XOR leaves of the triangle after its
+    // entry edge, and `y` lies on the exit edge unless it is the vertex
+    // opposite it.
     for k in 1..path.len() {
         let t = &tris[path[k] as usize];
         let (x, y) = (out[out.len() - 2], out[out.len() - 1]);
-        let d = *t
-            .iter()
-            .find(|&&v| v != x && v != y)
-            .expect("triangle does not hold its entry edge (internal error)");
+        debug_assert!(
+            t.contains(&x) && t.contains(&y) && x != y,
+            "triangle does not hold its entry edge (internal error)"
+        );
+        let d = t[0] ^ t[1] ^ t[2] ^ x ^ y;
         if k + 1 < path.len() {
             let s = slot_to(adj, path[k], path[k + 1]);
-            let exit_has_y = t[s] == y || t[(s + 1) % 3] == y;
-            if !exit_has_y {
+            if t[(s + 2) % 3] == y {
                 out.push(x);
             }
         }
