@@ -571,7 +571,9 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Value {
         "rows": rows,
         "exponent": {
             "stripify_ms": fit("stripify_ms"),
+            "meshopt_stripify_ms": fit("meshopt_stripify_ms"),
             "simplify_ms": fit("simplify_ms"),
+            "meshopt_simplify_to_10_ms": fit("meshopt_simplify_to_10_ms"),
             "build_ms": fit("build_ms"),
             "model_bytes": fit("model_bytes"),
             "extract_lod0_us": fit("extract_lod0_us"),
