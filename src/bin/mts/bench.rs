@@ -392,8 +392,9 @@ fn measure_model(
 }
 
 /// Table 2: microseconds per LoD change over each sequence, with the
-/// coherence cache and from scratch (median of three passes, each from a
-/// fresh extractor).
+/// coherence cache and from scratch: medians of five passes each, the two
+/// interleaved (a drift of the machine's speed hits both alike), each
+/// pass from a fresh extractor whose construction is not timed.
 fn measure_sequences(model: &MtsModel, requests: usize) -> Value {
     let max_lod = model.max_lod();
     let mut out = serde_json::Map::new();
@@ -406,27 +407,30 @@ fn measure_sequences(model: &MtsModel, requests: usize) -> Value {
         ("random", sequence::random(max_lod, requests, 1)),
     ] {
         let n = lods.len().max(1) as f64;
-        let mut ex = Extractor::new(model);
-        let coherent = time_us(3, || {
-            ex = Extractor::new(model);
+        let pass = |coherent: bool| {
+            let mut ex = Extractor::new(model);
+            let t = Instant::now();
             for &l in &lods {
-                ex.set_lod(l);
+                if coherent {
+                    ex.set_lod(l);
+                } else {
+                    ex.set_lod_from_scratch(l);
+                }
             }
-        });
-        let scratch = time_us(3, || {
-            ex = Extractor::new(model);
-            for &l in &lods {
-                ex.set_lod_from_scratch(l);
-            }
-        });
-        // The extractor's construction is inside both timings; take it out.
-        let new = time_us(3, || ex = Extractor::new(model));
+            t.elapsed().as_secs_f64() * 1e6
+        };
+        let (mut coherent, mut scratch) = (Vec::new(), Vec::new());
+        for _ in 0..5 {
+            coherent.push(pass(true));
+            scratch.push(pass(false));
+        }
+        let (coherent, scratch) = (median(coherent), median(scratch));
         out.insert(
             seq.into(),
             json!({
                 "requests": lods.len(),
-                "mts_coherent_us": (coherent - new).max(0.0) / n,
-                "mts_scratch_us": (scratch - new).max(0.0) / n,
+                "mts_coherent_us": coherent / n,
+                "mts_scratch_us": scratch / n,
             }),
         );
     }
@@ -705,7 +709,7 @@ pub fn report(results: &Value) -> String {
         }
     }
     let _ = writeln!(s, "\n## Table 2: microseconds per LoD change\n");
-    let _ = writeln!(s, "Sequences of `mts::model::sequence` (linear: coarsest to finest in equal steps; exponential: triangle counts in geometric steps; random: uniform, seed 1); medians of three passes.\n");
+    let _ = writeln!(s, "Sequences of `mts::model::sequence` (linear: coarsest to finest in equal steps; exponential: triangle counts in geometric steps; random: uniform, seed 1); medians of five passes each, with and without coherence interleaved, each from a fresh extractor (its construction not timed).\n");
     let _ = writeln!(s, "| model | linear coherent | linear without | × | exponential coherent | exponential without | × | random coherent | random without | × |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
     for r in &models {
