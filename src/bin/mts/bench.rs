@@ -611,8 +611,57 @@ const PAPER_TABLE_3: [(&str, &str, &str); 3] = [
     ("69.4K", "92K", "83K"),
 ];
 
-fn f(v: &Value) -> f64 {
+/// A JSON number, NaN when absent.
+pub fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
+}
+
+/// The immediate-mode Figure 6 row of `method` at the share of `at`
+/// (`null` when not measured).
+pub fn figure6_row(rows: &[Value], at: &Value, method: &str) -> Value {
+    rows.iter()
+        .find(|y| y["share"] == at["share"] && y["method"] == method && y["mode"] == "immediate")
+        .cloned()
+        .unwrap_or(Value::Null)
+}
+
+/// The scale section's table and fitted exponents (the report's and the
+/// README's).
+pub fn scale_table(s: &mut String, results: &Value) {
+    let rows = results["scale"]["rows"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let _ = writeln!(s, "Stripify and simplify (whole sequence) each timed alone, beside meshoptimizer's `stripify` and `simplify` to 10%; build is the whole pipeline (stripify beside simplify, then the model).\n");
+    let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes | peak RSS bytes (process so far) | LoD 0 extraction µs |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    for r in &rows {
+        let _ = writeln!(
+            s,
+            "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} | {} | {:.0} |",
+            r["triangles"],
+            f(&r["stripify_ms"]),
+            f(&r["meshopt_stripify_ms"]),
+            f(&r["simplify_ms"]),
+            f(&r["meshopt_simplify_to_10_ms"]),
+            f(&r["build_ms"]),
+            r["model_bytes"],
+            r["peak_rss_bytes"],
+            f(&r["extract_lod0_us"]),
+        );
+    }
+    let e = &results["scale"]["exponent"];
+    let _ = writeln!(
+        s,
+        "\nFitted growth exponents (y ~ triangles^k): stripify {:.2} (meshoptimizer {:.2}), simplify {:.2} (meshoptimizer to 10% {:.2}), build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.",
+        f(&e["stripify_ms"]),
+        f(&e["meshopt_stripify_ms"]),
+        f(&e["simplify_ms"]),
+        f(&e["meshopt_simplify_to_10_ms"]),
+        f(&e["build_ms"]),
+        f(&e["model_bytes"]),
+        f(&e["extract_lod0_us"]),
+    );
 }
 
 /// `report.md` from the results.
@@ -895,21 +944,11 @@ pub fn report(results: &Value) -> String {
         let _ = writeln!(s, "|---|---|---|---|---|---|---|");
         for r in &models {
             let rows = r["figure6"]["rows"].as_array().cloned().unwrap_or_default();
-            let find = |x: &Value, method: &str| {
-                rows.iter()
-                    .find(|y| {
-                        y["share"] == x["share"]
-                            && y["method"] == method
-                            && y["mode"] == "immediate"
-                    })
-                    .cloned()
-                    .unwrap_or(Value::Null)
-            };
             for x in rows
                 .iter()
                 .filter(|x| x["method"] == "mts" && x["mode"] == "immediate")
             {
-                let list = find(x, "list");
+                let list = figure6_row(&rows, x, "list");
                 let tri = f(&x["triangles"]);
                 let _ = writeln!(
                     s,
@@ -949,36 +988,9 @@ pub fn report(results: &Value) -> String {
             f(&scene["triangles_per_second"]) / 1e6,
         );
     }
-    if let Some(rows) = results["scale"]["rows"].as_array() {
+    if results["scale"]["rows"].is_array() {
         let _ = writeln!(s, "\n## Scale: generated icospheres\n");
-        let _ = writeln!(s, "Stripify and simplify (whole sequence) each timed alone, beside meshoptimizer's `stripify` and `simplify` to 10%; build is the whole pipeline (stripify beside simplify, then the model).\n");
-        let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes | peak RSS bytes (process so far) | LoD 0 extraction µs |");
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
-        for r in rows {
-            let _ = writeln!(
-                s,
-                "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} | {} | {:.0} |",
-                r["triangles"],
-                f(&r["stripify_ms"]),
-                f(&r["meshopt_stripify_ms"]),
-                f(&r["simplify_ms"]),
-                f(&r["meshopt_simplify_to_10_ms"]),
-                f(&r["build_ms"]),
-                r["model_bytes"],
-                r["peak_rss_bytes"],
-                f(&r["extract_lod0_us"]),
-            );
-        }
-        let e = &results["scale"]["exponent"];
-        let _ = writeln!(
-            s,
-            "\nFitted growth exponents (y ~ triangles^k): stripify {:.2}, simplify {:.2}, build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.",
-            f(&e["stripify_ms"]),
-            f(&e["simplify_ms"]),
-            f(&e["build_ms"]),
-            f(&e["model_bytes"]),
-            f(&e["extract_lod0_us"]),
-        );
+        scale_table(&mut s, results);
     }
     s
 }

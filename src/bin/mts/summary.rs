@@ -6,6 +6,7 @@
 //! `--readme` rewrites it there, `--check` fails when it differs from what
 //! the data gives (a test runs that on the committed report).
 
+use super::bench::{f, figure6_row, scale_table};
 use serde_json::Value;
 use std::fmt::Write as _;
 
@@ -13,10 +14,6 @@ use std::fmt::Write as _;
 pub const BEGIN: &str = "<!-- BEGIN mts bench summary: generated from the report's results.json by `mts bench summary`; edit the generator, not this block -->";
 /// Last line of the generated section in the README.
 pub const END: &str = "<!-- END mts bench summary -->";
-
-fn f(v: &Value) -> f64 {
-    v.as_f64().unwrap_or(f64::NAN)
-}
 
 fn name(v: &Value) -> &str {
     v["name"].as_str().unwrap_or("?")
@@ -551,20 +548,14 @@ fn render(s: &mut String, results: &Value, b: &Value) {
     let _ = writeln!(s, "Frames per second with a LoD change before every frame (immediate) and with one extraction per second, per method; the draw alone (MTS strips against the meshoptimizer-ordered list) and one MTS LoD change (extraction and dirty-range upload). {} × {} pixels.\n", b["figure6"]["width"], b["figure6"]["height"]);
     let _ = writeln!(s, "| share | triangles | indices mts / list | draw ms mts / list | LoD change µs | fps immediate: mts / list / pm / multilevel / cluster / discrete |");
     let _ = writeln!(s, "|---|---|---|---|---|---|");
-    let find = |x: &Value, method: &str| {
-        rows.iter()
-            .find(|y| y["share"] == x["share"] && y["method"] == method && y["mode"] == "immediate")
-            .cloned()
-            .unwrap_or(Value::Null)
-    };
     for x in rows
         .iter()
         .filter(|x| x["method"] == "mts" && x["mode"] == "immediate")
     {
-        let list = find(x, "list");
+        let list = figure6_row(&rows, x, "list");
         let fps: Vec<String> = ["mts", "list", "pm", "multilevel", "cluster", "discrete"]
             .iter()
-            .map(|m| format!("{:.0}", f(&find(x, m)["fps"])))
+            .map(|m| format!("{:.0}", f(&figure6_row(&rows, x, m)["fps"])))
             .collect();
         let _ = writeln!(
             s,
@@ -587,36 +578,11 @@ fn render(s: &mut String, results: &Value, b: &Value) {
 }
 
 fn scale(s: &mut String, results: &Value) {
-    let Some(rows) = results["scale"]["rows"].as_array() else {
-        return;
-    };
-    let _ = writeln!(s, "### Scale (generated icospheres)\n");
-    let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes | LoD 0 extraction µs |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|");
-    for r in rows {
-        let _ = writeln!(
-            s,
-            "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} | {:.0} |",
-            r["triangles"],
-            f(&r["stripify_ms"]),
-            f(&r["meshopt_stripify_ms"]),
-            f(&r["simplify_ms"]),
-            f(&r["meshopt_simplify_to_10_ms"]),
-            f(&r["build_ms"]),
-            r["model_bytes"],
-            f(&r["extract_lod0_us"]),
-        );
+    if results["scale"]["rows"].is_array() {
+        let _ = writeln!(s, "### Scale (generated icospheres)\n");
+        scale_table(s, results);
+        let _ = writeln!(s);
     }
-    let e = &results["scale"]["exponent"];
-    let _ = writeln!(
-        s,
-        "\nFitted growth exponents (y ~ triangles^k): stripify {:.2}, simplify {:.2}, build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.\n",
-        f(&e["stripify_ms"]),
-        f(&e["simplify_ms"]),
-        f(&e["build_ms"]),
-        f(&e["model_bytes"]),
-        f(&e["extract_lod0_us"]),
-    );
 }
 
 /// `readme` with its generated section replaced by `section`; `None`
