@@ -112,13 +112,22 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
     } else {
         STAGE_REPEAT
     };
+    // The scene row's model: the bunny when measured, else the first one.
+    let scene_name = inputs
+        .iter()
+        .map(|(n, _)| n)
+        .find(|n| *n == "bunny.ply")
+        .or(inputs.first().map(|(n, _)| n))
+        .cloned();
+    let mut scene = Value::Null;
     for (name, mesh) in &inputs {
         progress(name);
-        models.push(measure_model(
-            name, mesh, requests, repeat, &renderer, shares, frames,
-        )?);
+        let (row, model) = measure_model(name, mesh, requests, repeat, &renderer, shares, frames)?;
+        models.push(row);
+        if scene_name.as_ref() == Some(name) {
+            scene = measure_scene(name, &model, options.quick, frames, &renderer, progress)?;
+        }
     }
-    let scene = measure_scene(&inputs, options.quick, frames, &renderer, progress)?;
     let scale = if options.quick {
         Value::Null
     } else {
@@ -242,22 +251,15 @@ fn time_us(repeat: usize, mut f: impl FnMut()) -> f64 {
 }
 
 /// The scene row: [`SCENE_INSTANCES`] instances (fewer with `--quick`) of
-/// the bunny when it is measured, else of the first model, on Figure 6's
-/// adapter; `null` without one.
+/// `model` on Figure 6's adapter; `null` without one.
 fn measure_scene(
-    inputs: &[(String, Mesh)],
+    name: &str,
+    model: &MtsModel,
     quick: bool,
     frames: usize,
     renderer: &Figure6,
     progress: &dyn Fn(&str),
 ) -> Result<Value> {
-    let Some((name, mesh)) = inputs
-        .iter()
-        .find(|(n, _)| n == "bunny.ply")
-        .or(inputs.first())
-    else {
-        return Ok(Value::Null);
-    };
     let instances = if quick {
         QUICK_SCENE_INSTANCES
     } else {
@@ -267,15 +269,14 @@ fn measure_scene(
         #[cfg(feature = "render")]
         Ok(r) => {
             progress(&format!("scene of {instances} × {name}"));
-            let (model, _, _) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
-            let mut row = r.measure_scene(&model, instances, frames)?;
-            row["model"] = Value::from(name.as_str());
+            let mut row = r.measure_scene(model, instances, frames)?;
+            row["model"] = Value::from(name);
             Ok(row)
         }
         #[cfg(not(feature = "render"))]
         Ok(never) => match *never {},
         Err(_) => {
-            let _ = (name, mesh, instances, frames, progress);
+            let _ = (name, model, instances, frames, progress);
             Ok(Value::Null)
         }
     }
@@ -329,7 +330,9 @@ fn measure_simplify(mesh: &Mesh, repeat: usize) -> Value {
         || mts::simplify(mesh, &SimplifyOptions::default()),
         || peers::meshopt::simplify(mesh, n / 10),
     );
-    let (_, (_, to_1)) = interleaved_ms(1, || (), || peers::meshopt::simplify(mesh, n / 100));
+    let to_1 = time_us(1, || {
+        std::hint::black_box(peers::meshopt::simplify(mesh, n / 100));
+    }) / 1e3;
     json!({
         "ms": ms,
         "max_lod": whole.collapses.max_lod(),
@@ -348,12 +351,12 @@ fn measure_model(
     renderer: &Figure6,
     shares: &[f64],
     frames: usize,
-) -> Result<Value> {
+) -> Result<(Value, MtsModel)> {
     let (model, _, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let file_bytes = model.to_bytes().len();
     let stats = model.stats();
-    Ok(json!({
+    let row = json!({
         "name": name,
         "triangles": mesh.triangle_count(),
         "vertices": mesh.vertex_count(),
@@ -388,7 +391,8 @@ fn measure_model(
                 Value::Null
             }
         },
-    }))
+    });
+    Ok((row, model))
 }
 
 /// Table 2: microseconds per LoD change over each sequence, with the
@@ -664,25 +668,68 @@ pub fn scale_table(s: &mut String, results: &Value) {
     );
 }
 
+/// The per-model strips table (the report's and the README's): the
+/// project's strips against meshoptimizer's on each input mesh.
+pub fn strips_table(s: &mut String, models: &[Value]) {
+    let _ = writeln!(
+        s, "The project's stripifier (adjacency included) against meshoptimizer's `optimize_vertex_cache_strip` + `stripify` on the input mesh, restart encoding; medians of interleaved runs. Each cell: mts / meshopt.\n");
+    let _ = writeln!(
+        s, "| model | triangles | strips | swaps | indices (restart) | indices per triangle | ACMR | ms |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    for r in models {
+        let (a, b) = (&r["stripify"], &r["stripify"]["meshopt"]);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} / {} | {} / {} | {} / {} | {:.4} / {:.4} | {:.3} / {:.3} | {:.1} / {:.1} |",
+            r["name"].as_str().unwrap_or("?"),
+            a["triangles"],
+            a["strips"],
+            b["strips"],
+            a["swaps"],
+            b["swaps"],
+            a["indices_restart"],
+            b["indices_restart"],
+            f(&a["indices_per_triangle"]),
+            f(&b["indices_per_triangle"]),
+            f(&a["acmr"]),
+            f(&b["acmr"]),
+            f(&a["ms"]),
+            f(&b["ms"]),
+        );
+    }
+}
+
+/// "CPU (N cores), OS" and the graphics adapter (or why there is none),
+/// for the report's and the README's first lines.
+pub fn machine_words(results: &Value) -> (String, String) {
+    let m = &results["machine"];
+    (
+        format!(
+            "{} ({} cores), {}",
+            m["cpu"].as_str().unwrap_or("?"),
+            m["cores"],
+            m["os"].as_str().unwrap_or("?")
+        ),
+        m["adapter"]
+            .as_str()
+            .or(m["adapter_note"].as_str())
+            .unwrap_or("none")
+            .to_string(),
+    )
+}
+
 /// `report.md` from the results.
 pub fn report(results: &Value) -> String {
     let mut s = String::new();
-    let m = &results["machine"];
+    let (machine, adapter) = machine_words(results);
     let _ = writeln!(s, "# mts bench report\n");
     let _ = writeln!(
         s,
-        "Command: `{}`{}. Machine: {} ({} cores), {}. Graphics adapter (Figure 6): {}.\n",
+        "Command: `{}`{}. Machine: {machine}. Graphics adapter (Figure 6): {adapter}.\n",
         results["command"].as_str().unwrap_or(""),
         results["elapsed_s"]
             .as_f64()
             .map_or_else(String::new, |e| format!(", {e:.0} s")),
-        m["cpu"].as_str().unwrap_or("?"),
-        m["cores"],
-        m["os"].as_str().unwrap_or("?"),
-        m["adapter"]
-            .as_str()
-            .or(m["adapter_note"].as_str())
-            .unwrap_or("none"),
     );
     let models = results["models"].as_array().cloned().unwrap_or_default();
     let _ = writeln!(s, "## Table 1: models and sizes (bytes)\n");
@@ -712,30 +759,7 @@ pub fn report(results: &Value) -> String {
         );
     }
     let _ = writeln!(s, "\n## Strips against meshoptimizer\n");
-    let _ = writeln!(s, "The project's stripifier (adjacency included) against meshoptimizer's `optimize_vertex_cache_strip` + `stripify` on the input mesh, restart encoding; medians of interleaved runs. Each cell: mts / meshopt.\n");
-    let _ = writeln!(s, "| model | triangles | strips | swaps | indices (restart) | indices per triangle | ACMR | ms |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
-    for r in &models {
-        let (a, b) = (&r["stripify"], &r["stripify"]["meshopt"]);
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} / {} | {} / {} | {} / {} | {:.4} / {:.4} | {:.3} / {:.3} | {:.1} / {:.1} |",
-            r["name"].as_str().unwrap_or("?"),
-            a["triangles"],
-            a["strips"],
-            b["strips"],
-            a["swaps"],
-            b["swaps"],
-            a["indices_restart"],
-            b["indices_restart"],
-            f(&a["indices_per_triangle"]),
-            f(&b["indices_per_triangle"]),
-            f(&a["acmr"]),
-            f(&b["acmr"]),
-            f(&a["ms"]),
-            f(&b["ms"]),
-        );
-    }
+    strips_table(&mut s, &models);
     let _ = writeln!(s, "\n### Table 1, every method: bytes and build time\n");
     let _ = writeln!(s, "File bytes against the raw mesh with 16-bit indices (12 per vertex + 6 per triangle, the cluster-tree paper's reference). MTS builds the whole pipeline; the baselines start from the mesh and MTS's contraction sequence (the cluster tree makes its own clustering). Multilevel has no file format of its own: its figure is the in-memory structure.\n");
     let _ = writeln!(

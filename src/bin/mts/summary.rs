@@ -6,7 +6,7 @@
 //! `--readme` rewrites it there, `--check` fails when it differs from what
 //! the data gives (a test runs that on the committed report).
 
-use super::bench::{f, figure6_row, scale_table};
+use super::bench::{f, figure6_row, machine_words, scale_table, strips_table};
 use serde_json::Value;
 use std::fmt::Write as _;
 
@@ -53,22 +53,15 @@ fn yes(met: Option<bool>) -> &'static str {
 pub fn summary(results: &Value, report_dir: &str) -> String {
     let mut s = String::new();
     let models = results["models"].as_array().cloned().unwrap_or_default();
-    let m = &results["machine"];
     let _ = writeln!(s, "{BEGIN}\n");
     let elapsed = results["elapsed_s"]
         .as_f64()
         .map_or_else(String::new, |e| format!(" in {e:.0} s"));
+    let (machine, adapter) = machine_words(results);
     let _ = writeln!(
         s,
-        "Produced by `{}`{elapsed} on {} ({} cores), {}; graphics adapter: {}. The whole report is [{report_dir}/report.md]({report_dir}/report.md), its data `{report_dir}/results.json` (schema `docs/bench-schema.md`). Every figure below is copied from that data by `mts bench summary {report_dir}/results.json --readme README.md`, and `tests/readme.rs` fails when this section and the data disagree. Timings are medians of runs interleaved with the peer they are compared with; the machine is shared, so compare within a row.\n",
+        "Produced by `{}`{elapsed} on {machine}; graphics adapter: {adapter}. The whole report is [{report_dir}/report.md]({report_dir}/report.md), its data `{report_dir}/results.json` (schema `docs/bench-schema.md`). Every figure below is copied from that data by `mts bench summary {report_dir}/results.json --readme README.md`, and `tests/readme.rs` fails when this section and the data disagree. Timings are medians of runs interleaved with the peer they are compared with; the machine is shared, so compare within a row.\n",
         results["command"].as_str().unwrap_or("?"),
-        m["cpu"].as_str().unwrap_or("?"),
-        m["cores"],
-        m["os"].as_str().unwrap_or("?"),
-        m["adapter"]
-            .as_str()
-            .or(m["adapter_note"].as_str())
-            .unwrap_or("none"),
     );
     targets(&mut s, results, &models);
     strips(&mut s, &models);
@@ -350,27 +343,7 @@ fn targets(s: &mut String, results: &Value, models: &[Value]) {
 
 fn strips(s: &mut String, models: &[Value]) {
     let _ = writeln!(s, "### Strips against meshoptimizer\n");
-    let _ = writeln!(s, "The input mesh of each model cut into strips by the project's STRIPE-style stripifier and by meshoptimizer (`optimize_vertex_cache_strip` + `stripify`), restart encoding; each cell mts / meshoptimizer. Swaps, ACMR and indices are in the report's table.\n");
-    let _ = writeln!(
-        s,
-        "| model | triangles | strips | indices per triangle | ms |"
-    );
-    let _ = writeln!(s, "|---|---|---|---|---|");
-    for m in models {
-        let (a, b) = (&m["stripify"], &m["stripify"]["meshopt"]);
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} / {} | **{:.4}** / {:.4} | {:.1} / {:.1} |",
-            name(m),
-            a["triangles"],
-            a["strips"],
-            b["strips"],
-            f(&a["indices_per_triangle"]),
-            f(&b["indices_per_triangle"]),
-            f(&a["ms"]),
-            f(&b["ms"]),
-        );
-    }
+    strips_table(s, models);
     let _ = writeln!(s);
 }
 
