@@ -39,6 +39,9 @@ fn check_every_lod(mesh: &Mesh, c: &Collapses) {
     let n = mesh.vertex_count() + c.appended().len();
     let positions: Vec<Vec3> = mesh.positions.iter().chain(c.appended()).copied().collect();
     let mut previous = usize::MAX;
+    // No contraction makes a fin: an edge with more triangles than two or
+    // than the input's most crowded edge.
+    let input_crowding = most_crowded_edge(&mesh.triangles).max(2);
     for lod in 0..=c.max_lod() {
         let rep = c.representatives(lod);
         for v in 0..n as u32 {
@@ -73,7 +76,25 @@ fn check_every_lod(mesh: &Mesh, c: &Collapses) {
             }
         }
         assert_eq!(kept, tris.len());
+        assert!(
+            most_crowded_edge(&tris) <= input_crowding,
+            "LoD {lod} has an edge with {} triangles (input: {})",
+            most_crowded_edge(&tris),
+            most_crowded_edge(&mesh.triangles)
+        );
     }
+}
+
+/// The most triangles on one (unordered) edge.
+fn most_crowded_edge(tris: &[[u32; 3]]) -> usize {
+    let mut count = std::collections::HashMap::new();
+    for t in tris {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    count.into_values().max().unwrap_or(0)
 }
 
 #[test]
@@ -123,6 +144,50 @@ fn tetrahedron_cannot_contract() {
     assert_eq!(s.stop.triangles, 4);
     assert_eq!(s.stop.rejected_topology, s.stop.candidates_left);
     assert!(s.stop.candidates_left >= 4);
+}
+
+#[test]
+fn a_hole_of_three_edges_closes() {
+    // An octahedron without its face (+X, +Y, +Z): the hole's border is
+    // the three edges between those vertices. Contracting one of them
+    // merges the two others into one edge of two triangles and closes the
+    // hole. The link condition refuses it (+Z is a common neighbour of +X
+    // and +Y without a triangle on them), and contractions it allows keep
+    // the topology, so every LoD would keep a border; merging two border
+    // edges makes no fin and is allowed.
+    let mesh = Mesh {
+        positions: vec![Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z],
+        triangles: vec![
+            [0, 5, 2],
+            [0, 3, 5],
+            [0, 4, 3],
+            [1, 2, 5],
+            [1, 5, 3],
+            [1, 3, 4],
+            [1, 4, 2],
+        ],
+    };
+    let s = simplify(&mesh, &SimplifyOptions::default());
+    let c = &s.collapses;
+    check_every_lod(&mesh, c);
+    assert!(c.max_lod() >= 1, "{}", s.stop);
+    // The first contraction is along a hole edge, and closes it.
+    let first = c.steps()[0];
+    let hole = [0, 2, 4];
+    assert!(
+        hole.contains(&first.removed) && hole.contains(&first.kept),
+        "{first:?}"
+    );
+    let closed = c.triangles_at(&mesh, 1);
+    assert_eq!(closed.len(), 6);
+    let mut edges = std::collections::HashMap::new();
+    for t in &closed {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    assert!(edges.values().all(|&n| n == 2), "{closed:?}");
 }
 
 #[test]
