@@ -131,6 +131,29 @@ fn flat_grid_keeps_its_square_with_zero_error() {
 }
 
 #[test]
+fn flat_ties_go_to_the_nearest_neighbour() {
+    // A flat grid whose second and third columns are 0.1 apart: every
+    // contraction that keeps the square is free by the planes, so the
+    // order is the tie-break's (the distance moved). The first step joins
+    // two vertices of those columns in one row; vertex order would have
+    // started at the left column.
+    let xs = [0.0, 1.0, 1.1, 3.0, 4.0];
+    let mut mesh = flat_grid(4);
+    for p in &mut mesh.positions {
+        p.x = xs[p.x as usize];
+    }
+    let s = simplify(&mesh, &SimplifyOptions::default());
+    check_every_lod(&mesh, &s.collapses);
+    let first = s.collapses.steps()[0];
+    let (a, b) = (first.removed, first.kept);
+    assert_eq!(a / 5, b / 5, "{first:?}: not in one row");
+    let mut columns = [a % 5, b % 5];
+    columns.sort_unstable();
+    assert_eq!(columns, [1, 2], "{first:?}");
+    assert_eq!(first.error, 0.0, "the recorded error has no tie-break term");
+}
+
+#[test]
 fn tetrahedron_cannot_contract() {
     // Any contraction of a tetrahedron leaves two triangles on the same
     // three vertices (a fin): the sequence is empty.
