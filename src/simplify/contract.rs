@@ -139,7 +139,8 @@ struct Contractor {
     quadrics: Vec<Quadric>,
     /// The input positions each vertex stands for (its own and those
     /// contracted into it), for the tie-breaking term of
-    /// [`Contractor::cost`]; endpoint placement only.
+    /// [`Contractor::cost`]; empty in optimal placement, which does not
+    /// use them.
     anchors: Vec<PointSum>,
     /// Current triangles (input triangles with contracted vertices
     /// substituted); `[DEAD; 3]` once a contraction left them without three
@@ -229,11 +230,15 @@ impl Contractor {
         }
         // Each vertex's anchor: its own position, weighted like its face
         // planes (before border planes are added).
-        let anchors = quadrics
-            .iter()
-            .zip(&mesh.positions)
-            .map(|(q, p)| PointSum::point(p.as_dvec3(), q.weight()))
-            .collect();
+        let anchors = if options.placement == Placement::Endpoint {
+            quadrics
+                .iter()
+                .zip(&mesh.positions)
+                .map(|(q, p)| PointSum::point(p.as_dvec3(), q.weight()))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let fans = Fans::new(n, &tris);
         if options.boundary_weight > 0.0 {
             let borders = border_slots(&tris, &fans);
@@ -425,10 +430,9 @@ impl Contractor {
             if refused && self.refusals.contains(v, w) {
                 return;
             }
-            // The tie-break term of `cost`, without a division.
+            // The tie-break term of `cost`, its centre computed once.
             let p = self.p(w);
-            let spread = (p.length_squared() - 2.0 * p.dot(centre) + squares).max(0.0);
-            let cost = q.mean_error(p) + TIE_BREAK * spread;
+            let cost = q.mean_error(p) + TIE_BREAK * PointSum::spread(p, centre, squares);
             if best.is_none_or(|(bc, bw)| cost < bc || (cost == bc && w < bw)) {
                 best = Some((cost, w));
             }

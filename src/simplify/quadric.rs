@@ -192,8 +192,8 @@ impl PointSum {
     }
 
     /// The points' weighted mean `m` and `c`, the mean of their squared
-    /// lengths: [`PointSum::mean_error`] at `x` is `|x|² − 2 x·m + c`, one
-    /// division for many evaluations. `None` without weight.
+    /// lengths: [`PointSum::mean_error`] at `x` is [`PointSum::spread`]`(x,
+    /// m, c)`, one division for many evaluations. `None` without weight.
     #[must_use]
     #[inline]
     pub fn centre(&self) -> Option<(DVec3, f64)> {
@@ -203,17 +203,22 @@ impl PointSum {
         })
     }
 
+    /// `|x|² − 2 x·m + c` for the `(m, c)` of [`PointSum::centre`]
+    /// (rounding is clamped).
+    #[must_use]
+    #[inline]
+    pub fn spread(x: DVec3, mean: DVec3, squares: f64) -> f64 {
+        (x.length_squared() - 2.0 * x.dot(mean) + squares).max(0.0)
+    }
+
     /// The weighted mean squared distance from `x` to the points (zero
-    /// without weight; rounding is clamped).
+    /// without weight), by [`PointSum::centre`] and [`PointSum::spread`]:
+    /// callers that evaluate one sum at many points get the same values.
     #[must_use]
     #[inline]
     pub fn mean_error(&self, x: DVec3) -> f64 {
-        if self.weight > 0.0 {
-            let sum = self.weight * x.length_squared() - 2.0 * x.dot(self.sum) + self.squares;
-            sum.max(0.0) / self.weight
-        } else {
-            0.0
-        }
+        self.centre()
+            .map_or(0.0, |(mean, squares)| PointSum::spread(x, mean, squares))
     }
 }
 
@@ -264,7 +269,7 @@ mod tests {
         assert_eq!(PointSum::default().mean_error(DVec3::ONE), 0.0);
         let (m, c) = s.centre().unwrap();
         let x = DVec3::new(1.5, 1.0, 0.0);
-        assert!((x.length_squared() - 2.0 * x.dot(m) + c - s.mean_error(x)).abs() < 1e-12);
+        assert_eq!(PointSum::spread(x, m, c), s.mean_error(x));
     }
 
     #[test]
