@@ -81,12 +81,8 @@ fn renumber(mesh: &Mesh, order: u64) -> Mesh {
 fn quality_ratio(mesh: &Mesh, share: f64) -> f64 {
     const SAMPLES: usize = 100_000;
     let collapses = mts::simplify(mesh, &SimplifyOptions::default()).collapses;
-    let mut lod = collapses.lod_for_ratio(share);
-    let wanted = collapses.triangle_count(lod);
-    let theirs = mts::peers::meshopt::simplify(mesh, wanted);
-    if theirs.len() > wanted {
-        lod = collapses.lod_for_triangles(theirs.len());
-    }
+    let (theirs, lod) =
+        mts::peers::meshopt::simplify_to_lod(mesh, &collapses, collapses.lod_for_ratio(share));
     let ours = collapses.mesh_at(mesh, lod);
     let d = surface_distance(mesh.into(), (&ours).into(), SAMPLES).hausdorff;
     let e = surface_distance(

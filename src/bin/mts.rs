@@ -587,11 +587,9 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
     // asked for the same; when it stops above it, ours at its count.
     let mut peer_triangles = None;
     if !args.no_meshopt {
-        let wanted = collapses.triangle_count(lod);
-        let (theirs, their_ms) = median_ms(1, || peers::meshopt::simplify(&mesh, wanted));
-        if theirs.len() > wanted {
-            lod = collapses.lod_for_triangles(theirs.len());
-        }
+        let ((theirs, at), their_ms) =
+            median_ms(1, || peers::meshopt::simplify_to_lod(&mesh, collapses, lod));
+        lod = at;
         peer_triangles = Some((theirs, their_ms));
     }
     let triangles = collapses.triangles_at(&mesh, lod);

@@ -1,6 +1,7 @@
 //! meshoptimizer (through the `meshopt` crate) as the reference stripifier.
 
 use crate::mesh::Mesh;
+use crate::simplify::Collapses;
 use crate::strip::encode::RESTART_U32;
 use crate::strip::Strips;
 
@@ -49,6 +50,23 @@ pub fn simplify(mesh: &Mesh, target_triangles: usize) -> Vec<[u32; 3]> {
         None,
     );
     out.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
+
+/// meshoptimizer's `simplify` asked for the triangle count of `lod` of
+/// `collapses`, and the LoD to compare it with: `lod` itself, or, where
+/// meshoptimizer stops above that count, the LoD at its count. The quality
+/// comparisons (`mts simplify`, `mts bench`, `examples/order_spread.rs`)
+/// all go through here, so they compare at one triangle count.
+#[must_use]
+pub fn simplify_to_lod(mesh: &Mesh, collapses: &Collapses, lod: usize) -> (Vec<[u32; 3]>, usize) {
+    let wanted = collapses.triangle_count(lod);
+    let theirs = simplify(mesh, wanted);
+    let lod = if theirs.len() > wanted {
+        collapses.lod_for_triangles(theirs.len())
+    } else {
+        lod
+    };
+    (theirs, lod)
 }
 
 /// meshoptimizer's `optimize_vertex_cache` on a triangle list: the same
