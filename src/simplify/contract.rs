@@ -617,13 +617,13 @@ impl Contractor {
     /// time (bunny 98 → 108 ms in alternating runs).
     fn forward_error(&self, a: u32, b: u32) -> f64 {
         let (pa, pb) = (self.p(a), self.p(b));
-        let moved = self.nearest_around(pa, a, b, pb);
+        let moved = self.nearest_around(pa, a, b, pb, 0.0);
         // Every triangle of `a` dies (an ear, or a vertex between two
         // borders): the surface left is `b`'s.
         let nearest = if moved.is_finite() {
             moved
         } else {
-            self.nearest_around(pa, b, a, pb)
+            self.nearest_around(pa, b, a, pb, 0.0)
         };
         if nearest.is_finite() {
             nearest
@@ -715,24 +715,15 @@ impl Contractor {
     /// or `b` as they are before `a` moves, or the first one found within
     /// `within` (the callers only ask whether it is farther).
     fn nearest_old(&self, p: DVec3, a: u32, b: u32, within: f64) -> f64 {
-        let mut nearest = f64::INFINITY;
-        for v in [a, b] {
-            for &t in self.fans.get(v) {
-                let tri = self.tris[t as usize];
-                if tri[0] == DEAD {
-                    continue;
-                }
-                let [x, y, z] = tri.map(|u| self.p(u));
-                nearest = nearest.min((closest_on_triangle_f64(p, x, y, z) - p).length_squared());
-                if nearest <= within {
-                    return nearest;
-                }
-            }
+        let around_a = self.nearest_around(p, a, NONE, self.p(a), within);
+        if around_a <= within {
+            return around_a;
         }
-        nearest
+        around_a.min(self.nearest_around(p, b, NONE, self.p(b), within))
     }
 
-    /// Live triangles around `a` on edge `(a, x)`.
+    /// Live triangles around `a` on edge `(a, x)` (`a`'s list holds every
+    /// triangle on the edge).
     fn triangles_on(&self, a: u32, x: u32) -> usize {
         self.fans
             .get(a)
@@ -745,20 +736,24 @@ impl Contractor {
     }
 
     /// Squared distance from `p` to the nearest live triangle around `v`
-    /// that does not contain `without`, with `v` placed at `at` (infinite
-    /// when there is none).
-    fn nearest_around(&self, p: DVec3, v: u32, without: u32, at: DVec3) -> f64 {
-        self.fans
-            .get(v)
-            .iter()
-            .filter_map(|&t| {
-                let tri = self.tris[t as usize];
-                (tri[0] != DEAD && !tri.contains(&without)).then(|| {
-                    let [x, y, z] = tri.map(|w| if w == v { at } else { self.p(w) });
-                    (closest_on_triangle_f64(p, x, y, z) - p).length_squared()
-                })
-            })
-            .fold(f64::INFINITY, f64::min)
+    /// that does not contain `without` ([`NONE`] for none: no live
+    /// triangle holds it), with `v` placed at `at` (infinite when there is
+    /// none); the first one found within `within` ends the scan (0 for the
+    /// exact minimum).
+    fn nearest_around(&self, p: DVec3, v: u32, without: u32, at: DVec3, within: f64) -> f64 {
+        let mut nearest = f64::INFINITY;
+        for &t in self.fans.get(v) {
+            let tri = self.tris[t as usize];
+            if tri[0] == DEAD || tri.contains(&without) {
+                continue;
+            }
+            let [x, y, z] = tri.map(|w| if w == v { at } else { self.p(w) });
+            nearest = nearest.min((closest_on_triangle_f64(p, x, y, z) - p).length_squared());
+            if nearest <= within {
+                break;
+            }
+        }
+        nearest
     }
 
     /// Cost of contracting `v` with `w`: moving `v` onto `w`, or in optimal
@@ -1113,12 +1108,7 @@ impl Contractor {
                 dying += usize::from(tri.contains(&b));
             }
         }
-        let on_bw = self
-            .fans
-            .get(b)
-            .iter()
-            .filter(|&&t| self.tris[t as usize][0] != DEAD && self.tris[t as usize].contains(&w))
-            .count();
+        let on_bw = self.triangles_on(b, w);
         on_aw + on_bw - 2 * dying <= on_aw.max(on_bw).max(2)
     }
 
