@@ -1168,9 +1168,9 @@ impl Contractor {
         // neighbours keep their candidates and costs, so only those that a
         // guard refused something are asked again. In optimal mode every
         // neighbour sees a new vertex. Each is asked once: `b` is one of
-        // `a`'s neighbours, and `b`'s that are also `a`'s are not added
-        // again (a second refresh finds the same choice; asking the
-        // survivor twice was a third of all refreshes).
+        // `a`'s neighbours, and `b`'s refused neighbours that are also
+        // `a`'s are not added again (a second refresh finds the same
+        // choice; asking the survivor twice was a third of all refreshes).
         let mut ring = std::mem::take(&mut self.ring);
         ring.clear();
         self.partners_into(a, &mut ring);
