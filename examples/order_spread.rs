@@ -85,15 +85,7 @@ fn quality_ratio(mesh: &Mesh, share: f64) -> f64 {
         mts::peers::meshopt::simplify_to_lod(mesh, &collapses, collapses.lod_for_ratio(share));
     let ours = collapses.mesh_at(mesh, lod);
     let d = surface_distance(mesh.into(), (&ours).into(), SAMPLES).hausdorff;
-    let e = surface_distance(
-        mesh.into(),
-        Surface {
-            positions: &mesh.positions,
-            triangles: &theirs,
-        },
-        SAMPLES,
-    )
-    .hausdorff;
+    let e = surface_distance(mesh.into(), Surface::over(mesh, &theirs), SAMPLES).hausdorff;
     if e > 0.0 {
         d / e
     } else if d > 0.0 {

@@ -118,10 +118,7 @@ fn flat_grid_keeps_its_square_with_zero_error() {
     assert_eq!(corners, vec![0, 4, 20, 24]);
     let d = surface_distance(
         (&mesh).into(),
-        Surface {
-            positions: &mesh.positions,
-            triangles: &c.triangles_at(&mesh, lod),
-        },
+        Surface::over(&mesh, &c.triangles_at(&mesh, lod)),
         2000,
     );
     assert!(d.hausdorff < 1e-6, "{d:?}");
@@ -352,16 +349,8 @@ fn bunny_error_against_meshoptimizer() {
         let ours = c.triangles_at(&mesh, lod);
         let theirs = peers::meshopt::simplify(&mesh, ours.len());
         assert!(ours.len() <= (ratio * 69451.0).round() as usize);
-        let measure = |t: &[[u32; 3]]| {
-            surface_distance(
-                (&mesh).into(),
-                Surface {
-                    positions: &mesh.positions,
-                    triangles: t,
-                },
-                50_000,
-            )
-        };
+        let measure =
+            |t: &[[u32; 3]]| surface_distance((&mesh).into(), Surface::over(&mesh, t), 50_000);
         let (a, b) = (measure(&ours), measure(&theirs));
         assert!(
             a.hausdorff <= 1.15 * b.hausdorff,

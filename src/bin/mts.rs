@@ -606,14 +606,7 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
     let d = surface_distance((&mesh).into(), ours, args.samples);
     let mut peer = serde_json::Value::Null;
     if let Some((theirs, their_ms)) = peer_triangles {
-        let td = surface_distance(
-            (&mesh).into(),
-            Surface {
-                positions: &mesh.positions,
-                triangles: &theirs,
-            },
-            args.samples,
-        );
+        let td = surface_distance((&mesh).into(), Surface::over(&mesh, &theirs), args.samples);
         peer = json!({
             "triangles": theirs.len(),
             "ms": their_ms,

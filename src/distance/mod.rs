@@ -24,6 +24,18 @@ pub struct Surface<'a> {
     pub triangles: &'a [[u32; 3]],
 }
 
+impl<'a> Surface<'a> {
+    /// `mesh`'s positions under other triangles over its vertices: a LoD
+    /// from [`crate::Collapses::triangles_at`] or a peer's output.
+    #[must_use]
+    pub fn over(mesh: &'a crate::Mesh, triangles: &'a [[u32; 3]]) -> Surface<'a> {
+        Surface {
+            positions: &mesh.positions,
+            triangles,
+        }
+    }
+}
+
 impl<'a> From<&'a crate::Mesh> for Surface<'a> {
     fn from(mesh: &'a crate::Mesh) -> Surface<'a> {
         Surface {

@@ -502,14 +502,7 @@ fn measure_quality(mesh: &Mesh, model: &MtsModel) -> Value {
             let their_ms = t.elapsed().as_secs_f64() * 1e3;
             let ours = model.collapses().mesh_at(&ours_mesh, lod);
             let d = surface_distance(mesh.into(), (&ours).into(), SAMPLES);
-            let e = surface_distance(
-                mesh.into(),
-                Surface {
-                    positions: &mesh.positions,
-                    triangles: &theirs,
-                },
-                SAMPLES,
-            );
+            let e = surface_distance(mesh.into(), Surface::over(mesh, &theirs), SAMPLES);
             json!({
                 "share": share,
                 "mts": {"triangles": ours.triangle_count(), "hausdorff": d.hausdorff, "rms": d.rms},
