@@ -37,15 +37,12 @@
 //!   is forgotten and every vertex queued again; the sequence ends after a
 //!   round with no contraction.
 //! - **Flips are judged against both the current and the original normal**
-//!   of every moved triangle (75° at most against the current one, 90°
-//!   against the input's): a series of small turns could otherwise fold a
-//!   triangle over, and every LoD must keep the input's orientation.
-//! - **Folds wait**: a contraction is refused while other contractions
-//!   remain when two triangles that will share an edge at the survivor
-//!   end up facing each other (normals more than 105° apart, and further
-//!   apart than before); each may turn by less than the flip limit while
-//!   the pair folds into a spike. Once a round makes no contraction, folds
-//!   are allowed (the sequence still runs until no valid pair remains).
+//!   of every moved triangle (75° at most against each): a series of small
+//!   turns could otherwise fold a triangle over, and every LoD must keep
+//!   the input's orientation. Two moved triangles that end up facing each
+//!   other (a spike) are not refused: the distance checks above measure
+//!   them (a fold guard did before those existed; removed, see
+//!   `ARCHITECTURE.md`).
 //! - **Fins**: a contraction is rejected when the edge it makes from a
 //!   vertex adjacent to both endpoints would hold more than two triangles
 //!   and more than either merged edge held (the input's own non-manifold
@@ -98,13 +95,6 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
 /// Below this many vertices per thread the first choices are made on one
 /// thread (a spawn costs tens of microseconds).
 const PARALLEL_MIN_VERTICES: usize = 20_000;
-
-/// Two neighbours whose unit normals end up below this dot product (more
-/// than 105° apart) fold, see [`folds`]. Tuned on the README
-/// table (rows above 1.15 × meshoptimizer's Hausdorff, 14 without the
-/// guard): -0.25 gives 10, 0 (90°) 11, -0.5 (120°) 13. The response is
-/// not smooth: each limit moves some 1% rows of small models either way.
-const FOLD_COS: f64 = -0.25;
 
 /// A triangle that died, in [`Contractor::tris`].
 const DEAD: u32 = u32::MAX;
@@ -186,9 +176,6 @@ struct Contractor {
     /// Virtual partners of each vertex (empty unless enabled).
     partners: Vec<Vec<u32>>,
     removed: Vec<bool>,
-    /// Whether [`folds`] no longer refuses contractions (set
-    /// once a round without folds made no contraction).
-    allow_folds: bool,
     /// Scratch list of the moved triangles in [`Contractor::check`].
     fan: Vec<Turn>,
     /// Whether the vertex [`Contractor::check`] last looked at is on a
@@ -336,7 +323,6 @@ impl Contractor {
             fans,
             partners,
             removed: vec![false; n],
-            allow_folds: false,
             fan: Vec::new(),
             fan_on_border: false,
             mark: vec![0; n],
@@ -819,12 +805,8 @@ impl Contractor {
                 // neighbourhoods); try everything again unless the round
                 // changed nothing.
                 if self.steps.len() == round_start || self.refusals.count() == 0 {
-                    if self.allow_folds {
-                        self.stop = Some(self.stop_record(StopReason::NoValidPair, round));
-                        return;
-                    }
-                    // Only folds may be left: allow them from now on.
-                    self.allow_folds = true;
+                    self.stop = Some(self.stop_record(StopReason::NoValidPair, round));
+                    return;
                 }
                 self.requeue_all();
                 round_start = self.steps.len();
@@ -1032,7 +1014,7 @@ impl Contractor {
         }
         self.checked = checked;
         // Triangles of `a` that survive: no duplicate of a triangle of `b`,
-        // no flipped normal, no fold (their turns are kept for it).
+        // no flipped normal (their turns are kept for the distance checks).
         let mut fan = std::mem::take(&mut self.fan);
         fan.clear();
         let mut verdict = Ok(());
@@ -1051,9 +1033,6 @@ impl Contractor {
                 break;
             };
             fan.push(turn);
-        }
-        if verdict.is_ok() && !self.allow_folds && folds(&fan) {
-            verdict = Err(Reject::Flip);
         }
         self.fan = fan;
         verdict?;
@@ -1130,7 +1109,7 @@ impl Contractor {
     }
 
     /// Moving vertex `v` of triangle `t` to `p`: `None` when it flips (see
-    /// [`Contractor::flips`]), else the triangle's normals before and after
+    /// [`Contractor::flips`]), else the triangle's normal before the move
     /// and the vertices after and before `v`.
     fn turn(&self, t: u32, v: u32, p: DVec3) -> Option<Turn> {
         let tri = self.tris[t as usize];
@@ -1155,8 +1134,6 @@ impl Contractor {
             before: tri[(i + 2) % 3],
             now,
             now_length,
-            next,
-            next_length,
         })
     }
 
@@ -1372,11 +1349,9 @@ struct Turn {
     /// The vertices after and before the moved one.
     after: u32,
     before: u32,
-    /// Unnormalised normals before and after the move, and their lengths.
+    /// Unnormalised normal before the move, and its length.
     now: DVec3,
     now_length: f64,
-    next: DVec3,
-    next_length: f64,
 }
 
 /// Whether one of the moved vertex's surviving triangles (`fan`, from
@@ -1391,38 +1366,6 @@ fn creased(fan: &[Turn]) -> bool {
         || fan
             .iter()
             .any(|t| t.now.dot(sum) < CREASE_COS * t.now_length * length)
-}
-
-/// Whether a contraction folds two of the moved vertex's surviving
-/// triangles (`fan`, from [`Contractor::turn`]) that share an edge at it:
-/// their normals end up more than 105° apart ([`FOLD_COS`]) and further
-/// apart than before. The flip guard lets each triangle turn by up to 75°,
-/// so such a pair can fold into a spike that stands off the surface (lucy
-/// at 10%: 8 units off the statue, Hausdorff 1.46 × meshoptimizer's).
-/// Allocation-free; O(fan²) integer compares, one division per shared edge.
-fn folds(fan: &[Turn]) -> bool {
-    for (i, u) in fan.iter().enumerate() {
-        for (j, w) in fan.iter().enumerate() {
-            // `w` holds edge (moved, u.after) the other way round.
-            if w.before != u.after || i == j {
-                continue;
-            }
-            let scale = u.next_length * w.next_length;
-            let d = u.next.dot(w.next);
-            if d < FOLD_COS * scale {
-                let was = u.now_length * w.now_length;
-                let before = if was > 0.0 {
-                    u.now.dot(w.now) / was
-                } else {
-                    0.0
-                };
-                if d / scale < before {
-                    return true;
-                }
-            }
-        }
-    }
-    false
 }
 
 /// For each triangle, bit `slot` set when [`is_border`] holds for that
@@ -1544,11 +1487,12 @@ mod tests {
     ///
     /// Moving 0 onto 1 turns (0, 2, 3) by 52° and (0, 3, 4) by 5°, which
     /// the flip guard allows, but leaves them facing each other across
-    /// edge (1, 3): normals 113° apart, 66° before. The fold guard refuses
-    /// it until folds are allowed; once 2 has gone onto 1 (along the
-    /// border) the same move folds nothing.
+    /// edge (1, 3): normals 113° apart, 66° before, a spike. No guard
+    /// refuses it; the fan is creased, so the backward distance measures
+    /// the new triangles against the old fans, and the move waits at that
+    /// distance, far above its quadric cost.
     #[test]
-    fn a_move_that_folds_two_neighbours_waits_for_folds_to_be_allowed() {
+    fn a_move_that_folds_two_neighbours_is_measured_not_refused() {
         let mesh = Mesh {
             positions: vec![
                 Vec3::ZERO,
@@ -1561,13 +1505,37 @@ mod tests {
         };
         let mut c = Contractor::new(&mesh, &SimplifyOptions::default());
         let p1 = c.p(1);
-        assert!(matches!(c.check(0, 1, p1), Err(Reject::Flip)));
-        c.allow_folds = true;
         assert!(c.check(0, 1, p1).is_ok());
-        c.allow_folds = false;
-        assert!(c.check(2, 1, p1).is_ok());
-        c.contract(2, 1, p1, 0.0, 0.0);
-        assert!(c.check(0, 1, p1).is_ok());
+        assert_eq!(c.fan.len(), 2);
+        assert!(creased(&c.fan));
+        let cost = c.cost(0, 1);
+        let backward = c.backward_error(0, 1, cost).expect("the spike is measured");
+        // Independently: the farthest centroid of the new triangles (1, 2,
+        // 3) and (1, 3, 4) from the four old ones, weighted.
+        let p = |v: usize| mesh.positions[v];
+        let farthest = [[1, 2, 3], [1, 3, 4]]
+            .iter()
+            .map(|t: &[usize; 3]| {
+                let centroid = (p(t[0]) + p(t[1]) + p(t[2])) / 3.0;
+                mesh.triangles
+                    .iter()
+                    .map(|o| {
+                        let q = crate::distance::bvh::closest_on_triangle(
+                            centroid,
+                            p(o[0] as usize),
+                            p(o[1] as usize),
+                            p(o[2] as usize),
+                        );
+                        f64::from(q.distance_squared(centroid))
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            (backward - BACKWARD_WEIGHT * farthest).abs() < 1e-6,
+            "{backward} {farthest}"
+        );
+        assert!(backward > 1.5 * cost, "{backward} against {cost}");
     }
 
     /// An open square pyramid, apex 0 at height `h = 0.5` over the ring
