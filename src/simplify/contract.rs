@@ -1485,6 +1485,22 @@ mod tests {
     ///           1
     /// ```
     ///
+    /// The fan of apex 0 over the ring 1, 2, 3, 4 at `positions`, with
+    /// the move of 0 onto 1 checked: it passes the guards and leaves two
+    /// creased triangles in `fan`.
+    fn apex_0_onto_1(positions: [Vec3; 5]) -> (Mesh, Contractor) {
+        let mesh = Mesh {
+            positions: positions.to_vec(),
+            triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+        };
+        let mut c = Contractor::new(&mesh, &SimplifyOptions::default());
+        let p1 = c.p(1);
+        assert!(c.check(0, 1, p1).is_ok());
+        assert_eq!(c.fan.len(), 2);
+        assert!(creased(&c.fan));
+        (mesh, c)
+    }
+
     /// Moving 0 onto 1 turns (0, 2, 3) by 52° and (0, 3, 4) by 5°, which
     /// the flip guard allows, but leaves them facing each other across
     /// edge (1, 3): normals 113° apart, 66° before, a spike. No guard
@@ -1493,21 +1509,13 @@ mod tests {
     /// distance, far above its quadric cost.
     #[test]
     fn a_move_that_folds_two_neighbours_is_measured_not_refused() {
-        let mesh = Mesh {
-            positions: vec![
-                Vec3::ZERO,
-                Vec3::new(0.0, -1.0, -0.5),
-                Vec3::new(0.5, -0.5, 0.0),
-                Vec3::new(1.0, 2.0, 0.0),
-                Vec3::new(-1.0, 0.0, 2.0),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
-        };
-        let mut c = Contractor::new(&mesh, &SimplifyOptions::default());
-        let p1 = c.p(1);
-        assert!(c.check(0, 1, p1).is_ok());
-        assert_eq!(c.fan.len(), 2);
-        assert!(creased(&c.fan));
+        let (mesh, c) = apex_0_onto_1([
+            Vec3::ZERO,
+            Vec3::new(0.0, -1.0, -0.5),
+            Vec3::new(0.5, -0.5, 0.0),
+            Vec3::new(1.0, 2.0, 0.0),
+            Vec3::new(-1.0, 0.0, 2.0),
+        ]);
         let cost = c.cost(0, 1);
         let backward = c.backward_error(0, 1, cost).expect("the spike is measured");
         // Independently: the farthest centroid of the new triangles (1, 2,
@@ -1546,21 +1554,13 @@ mod tests {
     /// other centroid mirrors it. A flat fan is not creased.
     #[test]
     fn backward_distance_of_a_flattened_pyramid() {
-        let mesh = Mesh {
-            positions: vec![
-                Vec3::new(0.0, 0.0, 0.5),
-                Vec3::new(1.0, 0.0, 0.0),
-                Vec3::new(0.0, 1.0, 0.0),
-                Vec3::new(-1.0, 0.0, 0.0),
-                Vec3::new(0.0, -1.0, 0.0),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
-        };
-        let mut c = Contractor::new(&mesh, &SimplifyOptions::default());
-        let p1 = c.p(1);
-        assert!(c.check(0, 1, p1).is_ok());
-        assert_eq!(c.fan.len(), 2);
-        assert!(creased(&c.fan));
+        let (mesh, c) = apex_0_onto_1([
+            Vec3::new(0.0, 0.0, 0.5),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(0.0, -1.0, 0.0),
+        ]);
         let d = (2.0 / 3.0) / (2.0f64 + 4.0).sqrt();
         let expected = BACKWARD_WEIGHT * d * d;
         let got = c.backward_error(0, 1, 0.0).unwrap();
