@@ -618,6 +618,35 @@ impl Contractor {
         }
     }
 
+    /// The distances a popped choice `a → b` at queue cost `cost` must stay
+    /// within (endpoint placement, after [`Contractor::check`] passed):
+    /// `(forward, wait)`, the forward distance for the recorded error and
+    /// the largest of the distances, at which the choice waits where it
+    /// exceeds `cost`. The moved vertex's input position must stay near
+    /// the triangles that replace its fan ([`Contractor::forward_error`]);
+    /// where the fan is creased, those triangles must stay near the old
+    /// surface ([`Contractor::backward_error`]; a flat fan's replacements
+    /// lie in its plane), and where `a` is on a border, so must its new
+    /// border edges ([`Contractor::border_error`]). Each later check stops
+    /// early once it is within the largest so far.
+    fn distances(&self, a: u32, b: u32, cost: f32) -> (f64, f64) {
+        let forward = self.forward_error(a, b);
+        let mut wait = forward;
+        if creased(&self.fan) {
+            let limit = f64::from(cost).max(wait) * (1.0 + 1e-4);
+            if let Some(backward) = self.backward_error(a, b, limit) {
+                wait = wait.max(backward);
+            }
+        }
+        if self.fan_on_border {
+            let limit = f64::from(cost).max(wait) * (1.0 + 1e-4);
+            if let Some(border) = self.border_error(a, b, limit) {
+                wait = wait.max(border);
+            }
+        }
+        (forward, wait)
+    }
+
     /// [`BACKWARD_WEIGHT`] times the largest squared distance from the
     /// centroid of a triangle that replaces `a`'s fan (moving `a` onto
     /// `b`) to the old surface, the live triangles around `a` and `b`
@@ -851,32 +880,12 @@ impl Contractor {
             let target = self.target_position(a, b);
             match self.check(a, b, target) {
                 Ok(()) => {
-                    // The queue's cost is a lower bound: the vertex's own
-                    // input position must also stay near the triangles
-                    // that replace its fan. Where it is farther, the
-                    // choice waits at that cost. (After the guards: their
-                    // loads of the fan serve this too.)
-                    let forward = if self.placement == Placement::Endpoint {
-                        self.forward_error(a, b)
-                    } else {
-                        0.0
+                    // The queue's cost is a lower bound (after the guards:
+                    // their loads of the fan serve the distances too).
+                    let (forward, wait) = match self.placement {
+                        Placement::Endpoint => self.distances(a, b, cost),
+                        Placement::Optimal => (0.0, 0.0),
                     };
-                    // And the triangles that replace the fan must stay
-                    // near the old surface (measured where the fan is
-                    // creased: a flat fan's replacements lie in its plane).
-                    let mut wait = forward;
-                    if self.placement == Placement::Endpoint && creased(&self.fan) {
-                        let limit = f64::from(cost).max(forward) * (1.0 + 1e-4);
-                        if let Some(backward) = self.backward_error(a, b, limit) {
-                            wait = wait.max(backward);
-                        }
-                    }
-                    if self.placement == Placement::Endpoint && self.fan_on_border {
-                        let limit = f64::from(cost).max(wait) * (1.0 + 1e-4);
-                        if let Some(border) = self.border_error(a, b, limit) {
-                            wait = wait.max(border);
-                        }
-                    }
                     if wait as f32 > cost * (1.0 + 1e-4) {
                         let raised = wait as f32;
                         self.queued[a as usize] = (raised, b);
@@ -1473,18 +1482,6 @@ mod tests {
         assert!(borders > 10);
     }
 
-    /// A fan of four triangles around vertex 0, seen from above (+z):
-    ///
-    /// ```text
-    ///             3
-    ///           / |
-    ///   4 ---- 0  |        0 (0, 0, 0)      3 (1, 2, 0)
-    ///    \     | \ |        1 (0, -1, -0.5)  4 (-1, 0, 2)
-    ///      \   |  2        2 (0.5, -0.5, 0)
-    ///        \ | /
-    ///           1
-    /// ```
-    ///
     /// The fan of apex 0 over the ring 1, 2, 3, 4 at `positions`, with
     /// the move of 0 onto 1 checked: it passes the guards and leaves two
     /// creased triangles in `fan`.
@@ -1501,6 +1498,18 @@ mod tests {
         (mesh, c)
     }
 
+    /// A fan of four triangles around vertex 0, seen from above (+z):
+    ///
+    /// ```text
+    ///             3
+    ///           / |
+    ///   4 ---- 0  |        0 (0, 0, 0)      3 (1, 2, 0)
+    ///    \     | \ |        1 (0, -1, -0.5)  4 (-1, 0, 2)
+    ///      \   |  2        2 (0.5, -0.5, 0)
+    ///        \ | /
+    ///           1
+    /// ```
+    ///
     /// Moving 0 onto 1 turns (0, 2, 3) by 52° and (0, 3, 4) by 5°, which
     /// the flip guard allows, but leaves them facing each other across
     /// edge (1, 3): normals 113° apart, 66° before, a spike. No guard
