@@ -156,9 +156,9 @@ struct Edges {
     /// the junctions stayed where the input has them. Free, the vertex may
     /// move into one of the sheets (the junction moves with it: the merge
     /// test keeps the edge at three triangles). Over 6 vertex orders × 40
-    /// rows: beetle 10% median 1.11
-    /// → 1.04 and 1% 4.62 → 2.85 (2.56 in the file's order), no other row
-    /// moves (the geometric mean of the medians 0.746 → 0.736). Such a
+    /// rows: beetle 10% median 1.11 → 1.04 and 1% 4.62 → 2.85 (2.56 in
+    /// the file's order), no other row moves (the geometric mean of the
+    /// medians 0.746 → 0.736). Such a
     /// vertex still takes the merge test at every common neighbour, so no
     /// edge gains triangles; without it (the interior vertex's link test
     /// alone) beetle 10% read 0.94, but a merged edge could then exceed
@@ -198,8 +198,8 @@ struct Contractor {
     /// the link so a walk loads one line per member. Empty in optimal
     /// placement, which does not use them.
     members: Vec<(Vec3, u32)>,
-    /// Scratch list of the triangles around the survivor after a move
-    /// (corners and unit normal), for [`Contractor::forward_error`].
+    /// Scratch list of the triangles around the survivor after a move, for
+    /// [`Contractor::forward_error`].
     after: Vec<Prism>,
     /// Current triangles (input triangles with contracted vertices
     /// substituted); `[DEAD; 3]` once a contraction left them without three
@@ -660,14 +660,19 @@ impl Contractor {
     /// 40 rows the geometric mean of the median ratios to meshoptimizer's
     /// Hausdorff went 0.796 → 0.746 (bunny_res4 at 1% 2.25 → 0.78, cow
     /// at 10% 0.66 → 0.42, bunny at 1% 0.63 → 0.57; teapot at 10% 0.89 →
-    /// 1.02), and the recorded error follows the measured forward
-    /// distance. Only the members that decide the wait need an exact
-    /// distance: each scan stops at the first triangle within the largest
-    /// distance so far or `limit`. Measured and not kept: checking only
-    /// the first 8 members (0.764, fandisk at 1% 1.70) and only at creased
-    /// fans (0.781, bunny_res4 at 1% 2.32). Cost: the bunny's sequence
-    /// about 105 → 130 ms, the 1M icosphere's 1.85 → 2.65 s (a member is
-    /// a cache miss; a third of the checks are raised and pop twice).
+    /// 1.02). Only a member farther than the largest distance so far and
+    /// `limit` needs an exact distance: each scan stops at the first
+    /// triangle within them ([`nearest_within`]). [`Contractor::distances`]
+    /// passes the planes' mean error as `limit`, the rest of what the step
+    /// records, so the recorded error covers every member. Measured and
+    /// not kept: checking only the first 8 members (0.764, fandisk at 1%
+    /// 1.70) and only at creased fans (0.781, bunny_res4 at 1% 2.32), and
+    /// skipping interior fans flat within 5° (0.745; the 1M icosphere 2.6
+    /// → 2.24 s, the bunny unchanged). Cost: the bunny's sequence about
+    /// 103 → 130 ms, the 1M icosphere's 1.85 → 2.6 s in alternating runs
+    /// (18% of the bunny's checks and 25% of the icosphere's are raised by
+    /// a member and pop twice; callgrind on the bunny 898M → 1088M
+    /// instructions).
     fn forward_error(&mut self, a: u32, b: u32, limit: f64) -> f64 {
         let (pa, pb) = (self.p(a), self.p(b));
         let moved = self.nearest_around(pa, a, b, pb, 0.0);
@@ -1843,7 +1848,7 @@ mod tests {
         assert!((alone - own).abs() < 1e-12, "{alone}");
     }
 
-    /// `sheets` strips of four triangles meeting along the line 1 (-1, 0,
+    /// Strips of four triangles meeting along the line 1 (-1, 0,
     /// 0), 0 (0, 0, 0), 2 (1, 0, 0), each leaving it in its own direction
     /// `d` with the row `(-1, 0, 0) + d`, `d`, `(1, 0, 0) + d`: edges (0,
     /// 1) and (0, 2) hold one triangle per sheet.
