@@ -687,39 +687,52 @@ impl Contractor {
         if self.members[a as usize].1 == a {
             return nearest;
         }
-        // `b`'s fan after the move, once: `a`'s triangles without `b`
-        // (moved) and `b`'s without `a`, with unit normals for a cheap
-        // plane test (zero for a degenerate triangle, which always takes
-        // the exact test).
+        // `b`'s fan after the move: `a`'s triangles without `b` (moved),
+        // which settle most members by dot products, and `b`'s without
+        // `a`, added for the first member they do not settle (the full
+        // scan then covers both). Bunny: 2% fewer instructions than
+        // preparing both up front; the sequence is the same.
         let mut after = std::mem::take(&mut self.after);
         after.clear();
-        for (v, without) in [(a, b), (b, a)] {
-            for &t in self.fans.get(v) {
-                let tri = self.tris[t as usize];
-                if tri[0] == DEAD || tri.contains(&without) {
-                    continue;
-                }
-                after.push(Prism::new(tri.map(|w| if w == a { pb } else { self.p(w) })));
-            }
-        }
+        self.push_prisms(&mut after, a, b, pb);
+        let moved = after.len();
         let mut worst = nearest.max(limit);
         let mut member_farther = false;
         let mut u = self.members[a as usize].1;
         while u != a {
             let (p, next) = self.members[u as usize];
             prefetch(&self.members[next as usize]);
-            let d = nearest_within(&after, p.as_dvec3(), worst);
+            let p = p.as_dvec3();
+            u = next;
+            if over_within(&after[..moved], p, worst) {
+                continue;
+            }
+            if after.len() == moved {
+                self.push_prisms(&mut after, b, a, pb);
+            }
+            let d = nearest_within(&after, p, worst);
             if d > worst && d.is_finite() {
                 worst = d;
                 member_farther = true;
             }
-            u = next;
         }
         self.after = after;
         if member_farther {
             worst
         } else {
             nearest
+        }
+    }
+
+    /// Pushes a [`Prism`] for each live triangle around `v` without
+    /// `without`, `v` placed at `at`.
+    fn push_prisms(&self, out: &mut Vec<Prism>, v: u32, without: u32, at: DVec3) {
+        for &t in self.fans.get(v) {
+            let tri = self.tris[t as usize];
+            if tri[0] == DEAD || tri.contains(&without) {
+                continue;
+            }
+            out.push(Prism::new(tri.map(|w| if w == v { at } else { self.p(w) })));
         }
     }
 
@@ -1526,6 +1539,14 @@ impl Prism {
 /// farther); infinite when there are none. Most points lie over a
 /// triangle of the fan and are settled by dot products; the others take
 /// the exact closest-point test.
+/// Whether `p` lies over one of `triangles` within `within` of its plane
+/// (then within `within` of the surface).
+fn over_within(triangles: &[Prism], p: DVec3, within: f64) -> bool {
+    triangles
+        .iter()
+        .any(|t| t.over(p).is_some_and(|d| d <= within))
+}
+
 fn nearest_within(triangles: &[Prism], p: DVec3, within: f64) -> f64 {
     for t in triangles {
         if let Some(d) = t.over(p).filter(|&d| d <= within) {
