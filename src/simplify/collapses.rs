@@ -21,9 +21,13 @@ pub struct Collapse {
     /// sequences it is the other endpoint, and both endpoints are replaced
     /// by the vertex this step creates ([`Collapses::target`]).
     pub kept: u32,
-    /// Error of the mesh after this step: the running maximum of the
-    /// contractions' root-mean-square quadric distance, relative to the
-    /// bounding-box diagonal of the input. Non-decreasing along the sequence.
+    /// Error of the mesh after this step, relative to the bounding-box
+    /// diagonal of the input: the running maximum over the contractions so
+    /// far of the root-mean-square quadric distance and, with endpoint
+    /// placement, the forward distance, so every input vertex the removed
+    /// vertex stood for (itself included) lies within it of the kept
+    /// vertex's triangles right after the step. Non-decreasing along the
+    /// sequence.
     pub error: f32,
 }
 
