@@ -11,7 +11,7 @@ use glam::{DVec3, Vec3};
 /// A weighted sum of squared plane distances.
 ///
 /// Stores the ten distinct coefficients of the symmetric matrix and the
-/// total weight (the area for face planes), so that [`Quadric::rms`] can turn
+/// total weight (the area for face planes), so that [`Quadric::mean_error`] can turn
 /// a cost into a distance.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Quadric {
