@@ -42,9 +42,19 @@ pub struct SimplifyOptions {
     /// "virtual pairs", which can join separate parts). Off by default.
     pub pair_distance: Option<f32>,
     /// Weight of the planes that hold boundary edges in place, relative to
-    /// the area weight of face planes (a boundary edge of length `l` adds a
-    /// plane of weight `boundary_weight × l²` through it, perpendicular to
-    /// its triangle).
+    /// the `sqrt(area)` weight of face planes (a boundary edge of length
+    /// `l` adds a plane of weight `boundary_weight × l` through it,
+    /// perpendicular to its triangle, and its triangle's plane at the
+    /// same weight).
+    ///
+    /// The default is 15. Over 6 vertex orders × 40 rows (geometric mean
+    /// of the median Hausdorff ratios to meshoptimizer's; only open models
+    /// move): 5 → 0.739, 10 → 0.736, 12.5 → 0.730, 15 → 0.719, 20 →
+    /// 0.723, 30 → 0.718, 40 → 0.732, 100 → 0.740; over 10 orders 10 →
+    /// 0.741, 15 and 20 → 0.722. At 15 teapot at 10% went 1.02 → 0.69,
+    /// bunny_res3 at 1% 0.82 → 0.62 and beetle at 1% 2.85 → 2.33, and no
+    /// row's median rose by more than 0.05 (at 20 alligator at 1% 0.71 →
+    /// 0.92 did).
     pub boundary_weight: f64,
     /// Stop once the mesh has at most this many triangles (the sequence
     /// then ends there); `None` runs until no valid pair remains.
@@ -56,7 +66,7 @@ impl Default for SimplifyOptions {
         SimplifyOptions {
             placement: Placement::Endpoint,
             pair_distance: None,
-            boundary_weight: 10.0,
+            boundary_weight: 15.0,
             stop_at_triangles: None,
         }
     }
