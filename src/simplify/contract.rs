@@ -121,10 +121,12 @@ const TIE_BREAK: f64 = 3e-6;
 /// times 4 (the centroid sees a third of the moved corner's displacement,
 /// the worst point of the triangle more). Weights 1, 2, 3, 5 and 8
 /// measured worse on the 40 rows of the README table (0.817–0.918 against
-/// 0.794 as the geometric mean of the ratios, ungated).
+/// 0.794 as the geometric mean of the ratios, ungated). Measured again
+/// with the members' forward distance and boundary weight 15 (6 orders,
+/// geometric mean of the medians): 2 → 0.766, 4 → 0.719, 8 → 0.765.
 const BACKWARD_WEIGHT: f64 = 4.0;
 
-/// A fan is creased when one of its triangles' normals is more than 20°
+/// A fan is creased when one of its triangles' normals is more than 15°
 /// from the fan's area-weighted mean normal ([`creased`]); only then is
 /// the backward distance measured. Over 6 vertex orders of the 40 rows
 /// (geometric mean of the median ratios to meshoptimizer's Hausdorff;
@@ -132,13 +134,20 @@ const BACKWARD_WEIGHT: f64 = 4.0;
 /// sequence): ungated 0.809, 6 rows, about 65% more time; 10° 0.805, 5
 /// rows, 16% more instructions (and beetle at 10% 1.34 → 1.45); 20°
 /// 0.826, 6 rows, 5% more instructions, kept for the bunny's 150 ms
-/// budget (the sequence was at 125 ms).
-const CREASE_COS: f64 = 0.94;
+/// budget (the sequence was at 125 ms). Measured again with the members'
+/// forward distance, the three-triangle rule and boundary weight 15: 30°
+/// 0.778, 20° 0.719, 15° 0.698, 10° 0.710 (files' orders 0.768, 0.727,
+/// 0.707, 0.700; over 10 orders 20° 0.722, 15° 0.708); 15° costs about
+/// 4% more instructions than 20° on the bunny, 10° about 13%.
+const CREASE_COS: f64 = 0.966;
 
 /// Weight of the border distance ([`Contractor::border_error`]): the
 /// squared distance from the midpoint of a new border edge to the old
 /// surface, as it is (0.5 measured worse: alligator at 1% kept a median
 /// of 1.01 and a worst order of 1.49 × meshoptimizer's Hausdorff).
+/// Measured again with the members' forward distance and boundary weight
+/// 15 (6 orders, geometric mean of the medians): 0.5 → 0.728, 1 →
+/// 0.719, 2 → 0.718, 4 → 0.748, 8 → 0.776.
 const BORDER_WEIGHT: f64 = 1.0;
 
 /// The kinds of the edges at a vertex ([`Contractor::edges_at`]).
@@ -1564,7 +1573,7 @@ fn nearest_within(triangles: &[Prism], p: DVec3, within: f64) -> f64 {
 }
 
 /// Whether one of the moved vertex's surviving triangles (`fan`, from
-/// [`Contractor::turn`], normals before the move) is more than 20° from
+/// [`Contractor::turn`], normals before the move) is more than 15° from
 /// their area-weighted mean normal ([`CREASE_COS`]). A flat fan's
 /// replacements lie in its plane, so [`Contractor::backward_error`] is
 /// skipped there. A fan whose normals cancel out counts as creased.
