@@ -1268,6 +1268,9 @@ impl Contractor {
         let input = self.input_normal(t);
         // cos 75°: a pure 90° test lets a triangle fold over through a
         // series of near-90° turns (meshoptimizer makes the same choice).
+        // The limit against the current normal at 70° or 80° instead
+        // measured 0.719 and 0.710 against 0.698 (6 orders × 40 rows,
+        // geometric mean of the median ratios, after the members' check).
         let next_length = next.length();
         let limit = 0.25 * next_length;
         let now_length = now.length();
