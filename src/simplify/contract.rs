@@ -171,11 +171,11 @@ struct Edges {
     /// test keeps the edge at three triangles). Over 6 vertex orders × 40
     /// rows: beetle 10% median 1.11 → 1.04 and 1% 4.62 → 2.85 (2.56 in
     /// the file's order), no other row moves (the geometric mean of the
-    /// medians 0.746 → 0.736). Such a
-    /// vertex still takes the merge test at every common neighbour, so no
-    /// edge gains triangles; without it (the interior vertex's link test
-    /// alone) beetle 10% read 0.94, but a merged edge could then exceed
-    /// the input's most crowded. Freeing edges of four or more too
+    /// medians 0.746 → 0.736). Such a vertex still takes the merge test at
+    /// every common neighbour, so no edge gains triangles; without it (the
+    /// interior vertex's link test alone) beetle 10% read 0.94, but a
+    /// merged edge could then exceed the input's most crowded. Freeing
+    /// edges of four or more too
     /// (meshoptimizer's view again) took bunny_res3 and bunny_res4 at 1%
     /// to 1.75 and 1.61: their crowded edges are coincident triangle pairs
     /// of opposite winding, not fins.
@@ -675,7 +675,7 @@ impl Contractor {
     /// at 10% 0.66 → 0.42, bunny at 1% 0.63 → 0.57; teapot at 10% 0.89 →
     /// 1.02). Only a member farther than the largest distance so far and
     /// `limit` needs an exact distance: each scan stops at the first
-    /// triangle within them ([`nearest_within`]). [`Contractor::distances`]
+    /// triangle within them ([`over_within`], then [`exact_within`]). [`Contractor::distances`]
     /// passes the planes' mean error as `limit`, the rest of what the step
     /// records, so the recorded error covers every member. Measured and
     /// not kept: checking only the first 8 members (0.764, fandisk at 1%
@@ -707,7 +707,7 @@ impl Contractor {
         // preparing both up front; the sequence is the same.
         let mut after = std::mem::take(&mut self.after);
         after.clear();
-        self.push_prisms(&mut after, a, b, pb);
+        after.extend(self.corners_around(a, b, pb).map(Prism::new));
         let moved = after.len();
         let mut worst = nearest.max(limit);
         let mut member_farther = false;
@@ -721,9 +721,12 @@ impl Contractor {
                 continue;
             }
             if after.len() == moved {
-                self.push_prisms(&mut after, b, a, pb);
+                after.extend(self.corners_around(b, a, pb).map(Prism::new));
             }
-            let d = nearest_within(&after, p, worst);
+            if over_within(&after[moved..], p, worst) {
+                continue;
+            }
+            let d = exact_within(&after, p, worst);
             if d > worst && d.is_finite() {
                 worst = d;
                 member_farther = true;
@@ -734,18 +737,6 @@ impl Contractor {
             worst
         } else {
             nearest
-        }
-    }
-
-    /// Pushes a [`Prism`] for each live triangle around `v` without
-    /// `without`, `v` placed at `at`.
-    fn push_prisms(&self, out: &mut Vec<Prism>, v: u32, without: u32, at: DVec3) {
-        for &t in self.fans.get(v) {
-            let tri = self.tris[t as usize];
-            if tri[0] == DEAD || tri.contains(&without) {
-                continue;
-            }
-            out.push(Prism::new(tri.map(|w| if w == v { at } else { self.p(w) })));
         }
     }
 
@@ -891,18 +882,30 @@ impl Contractor {
     /// exact minimum).
     fn nearest_around(&self, p: DVec3, v: u32, without: u32, at: DVec3, within: f64) -> f64 {
         let mut nearest = f64::INFINITY;
-        for &t in self.fans.get(v) {
-            let tri = self.tris[t as usize];
-            if tri[0] == DEAD || tri.contains(&without) {
-                continue;
-            }
-            let [x, y, z] = tri.map(|w| if w == v { at } else { self.p(w) });
+        for [x, y, z] in self.corners_around(v, without, at) {
             nearest = nearest.min((closest_on_triangle_f64(p, x, y, z) - p).length_squared());
             if nearest <= within {
                 break;
             }
         }
         nearest
+    }
+
+    /// Corners of the live triangles around `v` that do not contain
+    /// `without` ([`NONE`] for none), with `v` placed at `at`: `v`'s fan
+    /// after a move, for [`Contractor::nearest_around`] and the member
+    /// walk's [`Prism`]s.
+    fn corners_around(
+        &self,
+        v: u32,
+        without: u32,
+        at: DVec3,
+    ) -> impl Iterator<Item = [DVec3; 3]> + '_ {
+        self.fans.get(v).iter().filter_map(move |&t| {
+            let tri = self.tris[t as usize];
+            (tri[0] != DEAD && !tri.contains(&without))
+                .then(|| tri.map(|w| if w == v { at } else { self.p(w) }))
+        })
     }
 
     /// Cost of contracting `v` with `w`: moving `v` onto `w`, or in optimal
@@ -1508,7 +1511,7 @@ struct Turn {
     now_length: f64,
 }
 
-/// A triangle prepared for [`nearest_within`]: corners, unit normal (zero
+/// A triangle prepared for [`over_within`]: corners, unit normal (zero
 /// when degenerate) and the inward normals of its edges' planes through
 /// the normal, so a point over the triangle's interior is found by dot
 /// products alone.
@@ -1550,25 +1553,12 @@ impl Prism {
     }
 }
 
-/// Squared distance from `p` to the nearest of `triangles`, or to the
-/// first one found within `within` (the caller only asks whether it is
-/// farther); infinite when there are none. Most points lie over a
-/// triangle of the fan and are settled by dot products; the others take
-/// the exact closest-point test.
-/// Whether `p` lies over one of `triangles` within `within` of its plane
-/// (then within `within` of the surface).
-fn over_within(triangles: &[Prism], p: DVec3, within: f64) -> bool {
-    triangles
-        .iter()
-        .any(|t| t.over(p).is_some_and(|d| d <= within))
-}
-
-fn nearest_within(triangles: &[Prism], p: DVec3, within: f64) -> f64 {
-    for t in triangles {
-        if let Some(d) = t.over(p).filter(|&d| d <= within) {
-            return d;
-        }
-    }
+/// Squared distance from `p` to the nearest of `triangles` by the exact
+/// closest-point test, or to the first one found within `within` (the
+/// caller only asks whether it is farther); infinite when there are none.
+/// For a point [`over_within`] did not settle: near an edge or a corner,
+/// or farther than `within`.
+fn exact_within(triangles: &[Prism], p: DVec3, within: f64) -> f64 {
     let mut nearest = f64::INFINITY;
     for t in triangles {
         nearest = nearest.min(t.distance2(p));
@@ -1577,6 +1567,15 @@ fn nearest_within(triangles: &[Prism], p: DVec3, within: f64) -> f64 {
         }
     }
     nearest
+}
+
+/// Whether `p` lies over one of `triangles` within `within` of its plane
+/// (then within `within` of the surface): four dot products a triangle,
+/// which settle most members of a fan.
+fn over_within(triangles: &[Prism], p: DVec3, within: f64) -> bool {
+    triangles
+        .iter()
+        .any(|t| t.over(p).is_some_and(|d| d <= within))
 }
 
 /// Whether one of the moved vertex's surviving triangles (`fan`, from
