@@ -85,8 +85,8 @@ fn check_every_lod(mesh: &Mesh, c: &Collapses) {
     }
 }
 
-/// The most triangles on one (unordered) edge.
-fn most_crowded_edge(tris: &[[u32; 3]]) -> usize {
+/// Triangles on each (unordered) edge.
+fn edge_counts(tris: &[[u32; 3]]) -> std::collections::HashMap<(u32, u32), usize> {
     let mut count = std::collections::HashMap::new();
     for t in tris {
         for i in 0..3 {
@@ -94,7 +94,12 @@ fn most_crowded_edge(tris: &[[u32; 3]]) -> usize {
             *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
         }
     }
-    count.into_values().max().unwrap_or(0)
+    count
+}
+
+/// The most triangles on one (unordered) edge.
+fn most_crowded_edge(tris: &[[u32; 3]]) -> usize {
+    edge_counts(tris).into_values().max().unwrap_or(0)
 }
 
 #[test]
@@ -124,7 +129,9 @@ fn flat_grid_keeps_its_square_with_zero_error() {
     assert!(d.hausdorff < 1e-6, "{d:?}");
     // ...and only cutting a corner costs something.
     assert!(c.error(lod + 1) > 0.0);
-    assert_eq!(s.stop.reason, StopReason::NoValidPair);
+    // An open sheet is cut down to nothing.
+    assert_eq!(s.stop.reason, StopReason::NoTriangleLeft);
+    assert_eq!(c.triangle_count(c.max_lod()), 0);
 }
 
 #[test]
@@ -151,19 +158,38 @@ fn flat_ties_go_to_the_nearest_neighbour() {
 }
 
 #[test]
-fn tetrahedron_cannot_contract() {
-    // Any contraction of a tetrahedron leaves two triangles on the same
-    // three vertices (a fin): the sequence is empty.
+fn tetrahedron_folds_flat_then_vanishes() {
+    // The first contraction lands one triangle on the three vertices of
+    // another, with the opposite winding (a doubled sheet); the second
+    // removes both. meshoptimizer's simplify also takes a tetrahedron to
+    // no triangle at a target of 0.
     let mesh = Mesh {
         positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
         triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
     };
     let s = simplify(&mesh, &SimplifyOptions::default());
-    assert_eq!(s.collapses.max_lod(), 0);
-    assert_eq!(s.stop.reason, StopReason::NoValidPair);
-    assert_eq!(s.stop.triangles, 4);
-    assert_eq!(s.stop.rejected_topology, s.stop.candidates_left);
-    assert!(s.stop.candidates_left >= 4);
+    let c = &s.collapses;
+    check_every_lod(&mesh, c);
+    assert_eq!(c.max_lod(), 2);
+    let folded = c.triangles_at(&mesh, 1);
+    assert_eq!(folded.len(), 2, "{folded:?}");
+    let corners = |t: [u32; 3]| {
+        let mut c = t;
+        c.sort_unstable();
+        c
+    };
+    assert_eq!(corners(folded[0]), corners(folded[1]));
+    let rotations = |t: [u32; 3]| [t, [t[1], t[2], t[0]], [t[2], t[0], t[1]]];
+    let reversed = [folded[1][0], folded[1][2], folded[1][1]];
+    assert!(
+        rotations(folded[0]).contains(&reversed),
+        "{folded:?}: same winding"
+    );
+    assert!(c.triangles_at(&mesh, 2).is_empty());
+    assert!(c.error(2) >= c.error(1) && c.error(1) > 0.0);
+    assert_eq!(s.stop.reason, StopReason::NoTriangleLeft);
+    assert_eq!((s.stop.triangles, s.stop.vertices), (0, 0));
+    assert_eq!(s.stop.to_string(), "no triangle left at LoD 2");
 }
 
 #[test]
@@ -251,9 +277,17 @@ fn stop_at_target_is_a_prefix_of_the_whole_sequence() {
     let k = part.collapses.max_lod();
     assert_eq!(part.collapses.steps(), &whole.collapses.steps()[..k]);
     assert_eq!(whole.collapses.lod_for_triangles(part.stop.triangles), k);
-    // Closed genus-0 surface: it ends at a tetrahedron-like hull.
-    assert_eq!(whole.stop.reason, StopReason::NoValidPair);
-    assert!(whole.stop.triangles >= 4, "{}", whole.stop);
+    // Closed genus-0 surface: it folds flat into a doubled triangle and
+    // then vanishes.
+    let last = whole.collapses.max_lod();
+    assert_eq!(
+        whole.stop.reason,
+        StopReason::NoTriangleLeft,
+        "{}",
+        whole.stop
+    );
+    assert_eq!(whole.collapses.triangle_count(last), 0);
+    assert_eq!(whole.collapses.triangle_count(last - 1), 2);
 }
 
 #[test]
@@ -405,6 +439,37 @@ fn bunny_error_against_meshoptimizer() {
 }
 
 #[test]
+fn non_manifold_models_against_meshoptimizer() {
+    // The two rows of the quality table that failed last: their ends are
+    // decided by fins (beetle's edges of three triangles) and coincident
+    // triangle pairs (bunny_res4's edges of four). Compared as the bench
+    // report compares them: our LoD at the share, meshoptimizer asked for
+    // its triangle count (and our LoD at meshoptimizer's count where it
+    // stops above it).
+    for name in ["beetle.obj", "bunny_res4.ply"] {
+        let Some(mesh) = model(name) else {
+            return;
+        };
+        let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
+        for ratio in [0.1, 0.01] {
+            let (theirs, lod) = peers::meshopt::simplify_to_lod(&mesh, &c, c.lod_for_ratio(ratio));
+            let ours = c.triangles_at(&mesh, lod);
+            let measure =
+                |t: &[[u32; 3]]| surface_distance((&mesh).into(), Surface::over(&mesh, t), 50_000);
+            let (a, b) = (measure(&ours), measure(&theirs));
+            assert!(
+                a.hausdorff <= 1.15 * b.hausdorff,
+                "{name} at {ratio}: Hausdorff {} ({} triangles) against meshopt {} ({})",
+                a.hausdorff,
+                ours.len(),
+                b.hausdorff,
+                theirs.len()
+            );
+        }
+    }
+}
+
+#[test]
 fn open_models_keep_their_borders() {
     // Border vertices only move along border edges, so at 10% every border
     // vertex of the LoD is an input border vertex and stays put.
@@ -413,14 +478,7 @@ fn open_models_keep_their_borders() {
     };
     let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
     let border = |tris: &[[u32; 3]]| {
-        let mut count = std::collections::HashMap::new();
-        for t in tris {
-            for i in 0..3 {
-                let (a, b) = (t[i], t[(i + 1) % 3]);
-                *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-            }
-        }
-        let mut v: Vec<u32> = count
+        let mut v: Vec<u32> = edge_counts(tris)
             .into_iter()
             .filter(|&(_, c)| c == 1)
             .flat_map(|((a, b), _)| [a, b])
@@ -447,4 +505,15 @@ fn beetle_keeps_every_invariant_with_its_fin_edges() {
     let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
     assert!(c.max_lod() > 1000, "{}", c.max_lod());
     check_every_lod(&mesh, &c);
+    // The fins fold onto their sheets on the way down (a doubled triangle
+    // is allowed): at 81 triangles, where refusing it left 31 edges of
+    // three, no more remain than meshoptimizer keeps (3).
+    let fins = |tris: &[[u32; 3]]| edge_counts(tris).values().filter(|&&n| n == 3).count();
+    let at = c.triangles_at(&mesh, c.lod_for_triangles(81));
+    assert!(
+        fins(&at) <= 3,
+        "{} edges of three at {} triangles",
+        fins(&at),
+        at.len()
+    );
 }

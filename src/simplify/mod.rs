@@ -81,6 +81,10 @@ pub enum StopReason {
     /// Every remaining candidate pair was rejected by a guard (counts in
     /// [`Stop`]), or no candidate pair was left at all.
     NoValidPair,
+    /// The last triangles were contracted away (a closed part folds flat
+    /// into a doubled triangle, which the next contraction removes, as
+    /// meshoptimizer's `simplify` does with a target of 0).
+    NoTriangleLeft,
 }
 
 /// Where and why the sequence ended.
@@ -98,9 +102,10 @@ pub struct Stop {
     pub candidates_left: usize,
     /// Of those, rejected because a triangle normal would flip.
     pub rejected_flip: usize,
-    /// Of those, rejected by a topology rule: a non-manifold fin (an edge
-    /// with extra triangles, or two triangles on the same three vertices)
-    /// would appear, or a border vertex would leave its border.
+    /// Of those, rejected by a topology rule: an edge would hold more
+    /// triangles than the input's most crowded edge (or two), an interior
+    /// vertex's move would pinch the surface, or a border vertex would
+    /// leave its border.
     pub rejected_topology: usize,
 }
 
@@ -112,6 +117,9 @@ impl std::fmt::Display for Stop {
                 "target reached at LoD {} ({} triangles)",
                 self.lod, self.triangles
             ),
+            StopReason::NoTriangleLeft => {
+                write!(f, "no triangle left at LoD {}", self.lod)
+            }
             StopReason::NoValidPair => write!(
                 f,
                 "no valid pair left at LoD {} ({} triangles, {} vertices): \
