@@ -1,11 +1,11 @@
 //! Quadric-error pair contractions recorded as one level-of-detail sequence.
 //!
 //! [`simplify`] runs Garland and Heckbert's greedy pair contraction
-//! (`contract.rs`) until no valid pair remains and records every step in
-//! [`Collapses`], which answers representatives, triangle counts and the
-//! naive replay at any LoD. `quadric.rs` holds the error quadrics,
-//! `pairs.rs` the candidate pairs, and `queue.rs`, `fans.rs` and
-//! `refusals.rs` the loop's flat structures: the priority queue, the
+//! (`contract.rs`) until no valid pair or no triangle remains and records
+//! every step in [`Collapses`], which answers representatives, triangle
+//! counts and the naive replay at any LoD. `quadric.rs` holds the error
+//! quadrics, `pairs.rs` the candidate pairs, and `queue.rs`, `fans.rs`
+//! and `refusals.rs` the loop's flat structures: the priority queue, the
 //! triangles around each vertex and the targets a guard refused.
 
 mod collapses;
@@ -58,7 +58,8 @@ pub struct SimplifyOptions {
     /// 15 → 0.698, 20 → 0.704.
     pub boundary_weight: f64,
     /// Stop once the mesh has at most this many triangles (the sequence
-    /// then ends there); `None` runs until no valid pair remains.
+    /// then ends there); `None` runs until no valid pair or no triangle
+    /// remains.
     pub stop_at_triangles: Option<usize>,
 }
 
