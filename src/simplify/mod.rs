@@ -76,15 +76,18 @@ impl Default for SimplifyOptions {
 
 /// Why a contraction sequence ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum StopReason {
     /// [`SimplifyOptions::stop_at_triangles`] was reached.
     TargetReached,
     /// Every remaining candidate pair was rejected by a guard (counts in
     /// [`Stop`]), or no candidate pair was left at all.
     NoValidPair,
-    /// The last triangles were contracted away (a closed part folds flat
-    /// into a doubled triangle, which the next contraction removes, as
-    /// meshoptimizer's `simplify` does with a target of 0).
+    /// No triangle is left: the last ones were contracted away (an open
+    /// sheet is cut down to nothing; a closed part folds flat into a
+    /// doubled triangle, which the next contraction removes, as
+    /// meshoptimizer's `simplify` does with a target of 0), or the input
+    /// had none.
     NoTriangleLeft,
 }
 
