@@ -48,17 +48,17 @@
 //!   input's most crowded edge, or than two (so a manifold input stays
 //!   manifold along its edges); for an interior vertex, when any common
 //!   neighbour but the two apexes of the edge would merge (the link
-//!   condition). This is weaker than the link condition where borders
-//!   meet: two border edges may merge into one manifold
-//!   edge, which closes a hole or a notch. The link condition keeps the
-//!   topology, so small open models kept every hole to the end (teapot at
-//!   1%: Hausdorff 2.25 × meshoptimizer's, 0.46 with this rule;
-//!   bunny_res3 2.78 → 1.03). Two triangles may end up on the same three
-//!   vertices (a tetrahedral pocket or a fin folds flat); the next
-//!   contraction on the doubled sheet removes both, so a closed part can
-//!   vanish and the sequence may end with no triangle, as meshoptimizer's
-//!   does (refused, beetle's fins stood to its floor: 1% at 2.33 ×
-//!   meshoptimizer's Hausdorff, 0.53 allowed).
+//!   condition). This is weaker than the link condition where borders meet:
+//!   two border edges may merge into one manifold edge, which closes a hole
+//!   or a notch. The link condition keeps the topology, so small open
+//!   models kept every hole to the end (teapot at 1%: Hausdorff 2.25 ×
+//!   meshoptimizer's, 0.46 with this rule; bunny_res3 2.78 → 1.03). Two
+//!   triangles may end up on the same three vertices (a tetrahedral pocket
+//!   or a fin folds flat); the next contraction on the doubled sheet
+//!   removes both, so a closed part can vanish and the sequence may end
+//!   with no triangle, as meshoptimizer's does (refused, beetle's fins
+//!   stood to its floor: 1% at 2.33 × meshoptimizer's Hausdorff, 0.53
+//!   allowed).
 //! - **Borders**: every edge without an orientation-consistent neighbour
 //!   (see [`TriangleAdjacency`]) adds a plane through it, perpendicular to
 //!   its triangle, to both endpoints' quadrics (weight `boundary_weight ×
@@ -170,22 +170,21 @@ struct Edges {
     ///
     /// An edge of three triangles (three sheets meeting, or a fin on a
     /// sheet) does not count. meshoptimizer sees both directions of such an
-    /// edge and treats its vertices as interior; tied to the edge, a
-    /// vertex on beetle's 47 such edges could only slide along them, and
-    /// the junctions stayed where the input has them. Free, the vertex may
-    /// move into one of the sheets (the junction moves with it: the merge
-    /// test keeps every edge within the input's most crowded). Over 6 vertex orders × 40
-    /// rows: beetle 10% median 1.11 → 1.04 and 1% 4.62 → 2.85 (2.56 in
-    /// the file's order), no other row moves (the geometric mean of the
-    /// medians 0.746 → 0.736). Such a vertex still takes the merge test at
-    /// every common neighbour (when this was measured it bounded each
-    /// merged edge by the two it joined); without it (the
-    /// interior vertex's link test alone) beetle 10% read 0.94, but a
-    /// merged edge could then exceed the input's most crowded. Freeing
-    /// edges of four or more too
-    /// (meshoptimizer's view again) took bunny_res3 and bunny_res4 at 1%
-    /// to 1.75 and 1.61: their crowded edges are coincident triangle pairs
-    /// of opposite winding, not fins.
+    /// edge and treats its vertices as interior; tied to the edge, a vertex
+    /// on beetle's 47 such edges could only slide along them, and the
+    /// junctions stayed where the input has them. Free, the vertex may move
+    /// into one of the sheets (the junction moves with it: the merge test
+    /// keeps every edge within the input's most crowded). Over 6 vertex
+    /// orders × 40 rows: beetle 10% median 1.11 → 1.04 and 1% 4.62 → 2.85
+    /// (2.56 in the file's order), no other row moves (the geometric mean
+    /// of the medians 0.746 → 0.736). Such a vertex still takes the merge
+    /// test at every common neighbour (when this was measured it bounded
+    /// each merged edge by the two it joined); without it (the interior
+    /// vertex's link test alone) beetle 10% read 0.94, but a merged edge
+    /// could then exceed the input's most crowded. Freeing edges of four or
+    /// more too (meshoptimizer's view again) took bunny_res3 and bunny_res4
+    /// at 1% to 1.75 and 1.61: their crowded edges are coincident triangle
+    /// pairs of opposite winding, not fins.
     slides: bool,
 }
 
@@ -681,23 +680,23 @@ impl Contractor {
     /// surface must stay near; every input vertex contracted into `a`
     /// before is another, and a move can leave one of those behind while
     /// `a`'s own stays close (the tip of a feature absorbed two steps
-    /// earlier). With them measured as well, over 6 vertex orders of the
-    /// 40 rows the geometric mean of the median ratios to meshoptimizer's
-    /// Hausdorff went 0.796 → 0.746 (bunny_res4 at 1% 2.25 → 0.78, cow
-    /// at 10% 0.66 → 0.42, bunny at 1% 0.63 → 0.57; teapot at 10% 0.89 →
+    /// earlier). With them measured as well, over 6 vertex orders of the 40
+    /// rows the geometric mean of the median ratios to meshoptimizer's
+    /// Hausdorff went 0.796 → 0.746 (bunny_res4 at 1% 2.25 → 0.78, cow at
+    /// 10% 0.66 → 0.42, bunny at 1% 0.63 → 0.57; teapot at 10% 0.89 →
     /// 1.02). Only a member farther than the largest distance so far and
     /// `limit` needs an exact distance: each scan stops at the first
-    /// triangle within them ([`over_within`], then [`exact_within`]). [`Contractor::distances`]
-    /// passes the planes' mean error as `limit`, the rest of what the step
-    /// records, so the recorded error covers every member. Measured and
-    /// not kept: checking only the first 8 members (0.764, fandisk at 1%
-    /// 1.70) and only at creased fans (0.781, bunny_res4 at 1% 2.32), and
-    /// skipping interior fans flat within 5° (0.745; the 1M icosphere 2.6
-    /// → 2.24 s, the bunny unchanged). Cost: the bunny's sequence about
-    /// 103 → 130 ms, the 1M icosphere's 1.85 → 2.6 s in alternating runs
-    /// (18% of the bunny's checks and 25% of the icosphere's are raised by
-    /// a member and pop twice; callgrind on the bunny 898M → 1088M
-    /// instructions).
+    /// triangle within them ([`over_within`], then [`exact_within`]).
+    /// [`Contractor::distances`] passes the planes' mean error as `limit`,
+    /// the rest of what the step records, so the recorded error covers
+    /// every member. Measured and not kept: checking only the first 8
+    /// members (0.764, fandisk at 1% 1.70) and only at creased fans (0.781,
+    /// bunny_res4 at 1% 2.32), and skipping interior fans flat within 5°
+    /// (0.745; the 1M icosphere 2.6 → 2.24 s, the bunny unchanged). Cost:
+    /// the bunny's sequence about 103 → 130 ms, the 1M icosphere's 1.85 →
+    /// 2.6 s in alternating runs (18% of the bunny's checks and 25% of the
+    /// icosphere's are raised by a member and pop twice; callgrind on the
+    /// bunny 898M → 1088M instructions).
     fn forward_error(&mut self, a: u32, b: u32, limit: f64) -> f64 {
         let (pa, pb) = (self.p(a), self.p(b));
         let moved = self.nearest_around(pa, a, b, pb, 0.0);
@@ -1187,16 +1186,16 @@ impl Contractor {
         //
         // A surviving triangle may land on the three vertices of one of
         // `b`'s (most often its other two corners are the apexes of edge
-        // (a, b): a tetrahedral pocket, a closed part folded flat, or a
-        // fin folding onto its sheet). The pair is a doubled sheet where the surface
-        // is, and the next contraction on it removes both; the merge test
-        // above still bounds every edge. Refusing it (as a link condition
-        // would) kept beetle's fins standing: at its floor of 81 triangles
-        // 31 edges still held three (meshoptimizer's 81 keep 3), and its
-        // 1% row read 2.33 × meshoptimizer's Hausdorff (median of 6 vertex
-        // orders). Allowed, with the crowding bound of the merge test:
-        // 0.53, the last two rows above 1.15 × pass, the geometric mean of
-        // the 40 rows' medians 0.698 → 0.684 (see ARCHITECTURE.md).
+        // (a, b): a tetrahedral pocket, a closed part folded flat, or a fin
+        // folding onto its sheet). The pair is a doubled sheet where the
+        // surface is, and the next contraction on it removes both; the
+        // merge test above still bounds every edge. Refusing it (as a link
+        // condition would) kept beetle's fins standing: at its floor of 81
+        // triangles 31 edges still held three (meshoptimizer's 81 keep 3),
+        // and its 1% row read 2.33 × meshoptimizer's Hausdorff (median of 6
+        // vertex orders). Allowed, with the crowding bound of the merge
+        // test: 0.53, the last two rows above 1.15 × pass, the geometric
+        // mean of the 40 rows' medians 0.698 → 0.684 (see ARCHITECTURE.md).
         let mut fan = std::mem::take(&mut self.fan);
         fan.clear();
         let mut verdict = Ok(());
