@@ -85,11 +85,60 @@ impl Mesh {
     }
 
     /// Length of the bounding-box diagonal (0 for an empty mesh); errors are
-    /// reported relative to it.
+    /// reported relative to it. Saturates at `f32::MAX` for boxes whose
+    /// diagonal `f32` cannot hold (coordinates near ±3.4e38); see
+    /// [`Mesh::diagonal_f64`].
     #[must_use]
     pub fn diagonal(&self) -> f32 {
-        self.bounds().map_or(0.0, |(lo, hi)| (hi - lo).length())
+        (self.diagonal_f64() as f32).min(f32::MAX)
     }
+
+    /// Length of the bounding-box diagonal in `f64`, exact for any finite
+    /// coordinates: the `f32` length where its squares neither overflow nor
+    /// become subnormal (every extent from 1e-18 to 1e18, so ordinary models
+    /// keep the value they always had, bit for bit), else the length
+    /// computed in `f64`, where the squares of any two finite `f32` fit.
+    ///
+    /// Cost: O(vertices).
+    #[must_use]
+    pub fn diagonal_f64(&self) -> f64 {
+        self.bounds().map_or(0.0, |(lo, hi)| diagonal_of(lo, hi))
+    }
+}
+
+/// A power of two that brings `positions` into a frame where `f32`
+/// squared distances neither overflow nor go subnormal: 1 when the largest
+/// coordinate magnitude lies in 2^-40..2^40 (every ordinary model: its
+/// arithmetic is untouched), else 2^-e for that magnitude's exponent e, so
+/// the scaled magnitudes are near 1. Scaling by a power of two is exact, so
+/// distances in the frame are the true ones times the scale, rounding
+/// included. Returns 1 for an empty or all-zero input. O(n).
+#[must_use]
+pub fn power_of_two_scale(positions: &[Vec3]) -> f64 {
+    let largest = positions
+        .iter()
+        .fold(0.0f32, |m, p| m.max(p.abs().max_element()));
+    if largest == 0.0 || !largest.is_finite() || (2f32.powi(-40)..=2f32.powi(40)).contains(&largest)
+    {
+        return 1.0;
+    }
+    // In f64: the scale of a subnormal magnitude (2^149) is beyond f32.
+    2f64.powi(-f64::from(largest).log2().floor() as i32)
+}
+
+/// Length of the box `lo..hi` as [`Mesh::diagonal_f64`] defines it.
+#[must_use]
+pub fn diagonal_of(lo: Vec3, hi: Vec3) -> f64 {
+    let extent = hi - lo;
+    let largest = extent.max_element();
+    if extent.is_finite() && (1e-18..=1e18).contains(&largest) {
+        return f64::from(extent.length());
+    }
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    (hi - lo).length()
+}
+
+impl Mesh {
 
     /// Checks the invariants listed on [`Mesh`].
     ///

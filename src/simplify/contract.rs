@@ -366,7 +366,7 @@ impl Contractor {
                 }
             }
         }
-        let diagonal = f64::from(mesh.diagonal()).max(f64::MIN_POSITIVE);
+        let diagonal = mesh.diagonal_f64().max(f64::MIN_POSITIVE);
         let mut partners = Vec::new();
         if let Some(d) = options.pair_distance {
             let pairs = virtual_pairs(&mesh.positions, &fans, &tris, d * mesh.diagonal());

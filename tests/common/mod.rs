@@ -57,13 +57,40 @@ pub fn random_surface() -> impl Strategy<Value = Mesh> {
     })
 }
 
+/// Whether `MTS_REQUIRE` (a comma-separated list, set by `.ci/run`) names
+/// `what`: then a missing resource fails the test instead of skipping it.
+pub fn required(what: &str) -> bool {
+    std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w.trim() == what))
+}
+
+/// `../shared/models`, or `None` (with a message saying the test is
+/// skipped) when it is absent; a failure instead when `MTS_REQUIRE` names
+/// `models`.
+pub fn models_dir() -> Option<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/models");
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    assert!(
+        !required("models"),
+        "{} not found and MTS_REQUIRE names models",
+        dir.display()
+    );
+    eprintln!("skipped: {} not found", dir.display());
+    None
+}
+
 /// A model from `../shared/models`, or `None` (with a message saying the test
-/// is skipped) when the directory is absent.
+/// is skipped) when the directory is absent (a failure when `MTS_REQUIRE`
+/// names `models`).
 pub fn model(name: &str) -> Option<Mesh> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/models")
-        .join(name);
+    let path = models_dir()?.join(name);
     if !path.exists() {
+        assert!(
+            !required("models"),
+            "{} not found and MTS_REQUIRE names models",
+            path.display()
+        );
         eprintln!(
             "skipped: {} not found (needs ../shared/models)",
             path.display()

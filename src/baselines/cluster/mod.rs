@@ -65,16 +65,36 @@ impl ClusterTree {
                 message: "no vertices".into(),
             });
         }
-        let joins = build::cluster(&mesh.positions);
-        let diagonal = mesh.diagonal();
+        // Distances are squared in f32: far-flung or tiny coordinates are
+        // clustered in a frame scaled by a power of two (exact; 1 for every
+        // ordinary model), and sizes scaled back.
+        let scale = crate::mesh::power_of_two_scale(&mesh.positions);
+        let joins = if scale == 1.0 {
+            build::cluster(&mesh.positions)
+        } else {
+            let scaled: Vec<_> = mesh
+                .positions
+                .iter()
+                .map(|&p| (p.as_dvec3() * scale).as_vec3())
+                .collect();
+            build::cluster(&scaled)
+        };
+        let diagonal = mesh.diagonal_f64() * scale;
         let steps: Vec<_> = joins
             .iter()
             .map(|(c, size)| crate::simplify::Collapse {
-                error: if diagonal > 0.0 { size / diagonal } else { 0.0 },
+                error: if diagonal > 0.0 {
+                    (f64::from(*size) / diagonal) as f32
+                } else {
+                    0.0
+                },
                 ..*c
             })
             .collect();
-        let sizes = joins.iter().map(|(_, s)| *s).collect();
+        let sizes = joins
+            .iter()
+            .map(|(_, s)| ((f64::from(*s) / scale) as f32).min(f32::MAX))
+            .collect();
         let counts = crate::model::format::replay_counts(mesh, &steps, false);
         let collapses = Collapses::new(mesh.vertex_count(), steps, counts, Vec::new());
         let levels = Levels::new(mesh, &collapses)?;

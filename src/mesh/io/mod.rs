@@ -1,4 +1,4 @@
-//! Reading meshes from files: OBJ (through `tobj`) and PLY (own reader).
+//! Reading meshes from files: OBJ and PLY, each with its own reader.
 //!
 //! Every loader returns a [`RawMesh`] whose positions are finite and whose
 //! indices are in range, or an error naming the file and the place; [`load`]

@@ -1,139 +1,461 @@
-//! Wavefront OBJ through `tobj`: polygons fan-triangulated, all objects and
-//! groups merged, materials ignored (a missing `.mtl` is fine).
+//! Wavefront OBJ reader: `v`, `f` and the element counts of `vt`/`vn`;
+//! polygons fan-triangulated, all objects and groups merged, lines (`l`),
+//! points (`p`), materials and everything else ignored.
 //!
-//! `tobj` reports errors without a position, so when it fails (or when a
-//! coordinate is not finite, which it accepts) this module scans the text
-//! once more to find the offending line. That scan runs only on the error
-//! path.
+//! An own reader rather than `tobj` (used until 2026-12): every error names
+//! the line and byte where it is, text that is not UTF-8 (UTF-16, binary
+//! data) is named as such, CR-only line endings work, and a face of any
+//! size is read in time linear in its corners. For the files `tobj`
+//! accepted it gives the same mesh, vertex for vertex: within each object
+//! or group (a new `o`/`g` after faces starts one) vertices are numbered in
+//! the order the faces first use them, and a vertex used by two objects is
+//! listed once for each, as `tobj` does without `single_index`; `v x y z w`
+//! divides by `w`. It is stricter where `tobj` accepted garbage: `l`
+//! statements are lines, not triangles; `vt`/`vn` indices must be in range;
+//! a face of one or two corners is counted in
+//! [`RawMesh::degenerate_in_source`] instead of vanishing.
 
 use crate::error::{Error, Place, Result};
 use crate::mesh::RawMesh;
 use glam::Vec3;
 use std::path::Path;
 
+/// One face as read: the line it is on and its corners' position indices
+/// (0-based, resolved, not yet checked against the position count).
+struct Face {
+    line: u64,
+    byte: u64,
+    corners: std::ops::Range<usize>,
+}
+
+/// A position, texture-coordinate or normal reference, resolved to 0-based,
+/// with where it was first seen past the end of its list.
+#[derive(Default)]
+struct Highest {
+    index: Option<(u64, u64, u64)>,
+}
+
+impl Highest {
+    fn see(&mut self, index: u64, line: u64, byte: u64) {
+        if self.index.is_none_or(|(i, _, _)| index > i) {
+            self.index = Some((index, line, byte));
+        }
+    }
+}
+
+/// State of the reader between lines.
+struct Reader<'p> {
+    path: &'p Path,
+    positions: Vec<Vec3>,
+    texcoord_count: u64,
+    normal_count: u64,
+    /// Faces of the current object, not yet numbered.
+    faces: Vec<Face>,
+    corners: Vec<u64>,
+    highest_texcoord: Highest,
+    highest_normal: Highest,
+    raw: RawMesh,
+    /// Per input position: the object that last numbered it and the number
+    /// it got there (object-local vertex numbering, as `tobj`).
+    stamp: Vec<u32>,
+    local: Vec<u32>,
+    object: u32,
+}
+
 /// Parses OBJ text into a raw mesh (geometry only).
 ///
 /// # Errors
-/// [`Error::Parse`] naming the line for malformed statements, out-of-range
-/// face indices and non-finite coordinates.
+/// [`Error::Parse`] naming the line and byte for text that is not UTF-8,
+/// malformed statements, out-of-range `v`, `vt` or `vn` indices in faces,
+/// and non-finite coordinates.
 ///
-/// Cost: O(file size).
+/// Cost: O(file size) time; memory linear in the elements read.
 pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
+    let err = |line: u64, byte: u64, message: String| Error::Parse {
+        file: path.to_owned(),
+        place: Place::line(line).at_byte(byte),
+        message,
     };
-    let mut reader = bytes;
-    let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    });
-    let models = match loaded {
-        Ok((models, _materials_ignored)) => models,
-        Err(e) => {
-            let (place, what) = locate_error(bytes, e);
-            return Err(Error::Parse {
-                file: path.to_owned(),
-                place,
-                message: what,
-            });
-        }
-    };
-
-    let mut raw = RawMesh::default();
-    for model in &models {
-        let m = &model.mesh;
-        let base = raw.positions.len() as u64;
-        if base + (m.positions.len() / 3) as u64 > u64::from(u32::MAX) {
-            return Err(Error::InvalidMesh {
-                source_name: path.display().to_string(),
-                message: "more than 2^32 - 1 vertices".into(),
-            });
-        }
-        raw.positions.extend(
-            m.positions
-                .chunks_exact(3)
-                .map(|p| Vec3::new(p[0], p[1], p[2])),
-        );
-        raw.triangles.extend(
-            m.indices
-                .chunks_exact(3)
-                .map(|t| [t[0], t[1], t[2]].map(|i| i + base as u32)),
-        );
+    if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) {
+        return Err(err(
+            1,
+            0,
+            "UTF-16 text (byte-order mark): OBJ is read as UTF-8 or ASCII; save the file as UTF-8"
+                .into(),
+        ));
     }
-    if raw.positions.iter().any(|p| !p.is_finite()) {
-        let place = find_line(bytes, |words| {
-            words.first() == Some(&"v")
-                && words[1..]
-                    .iter()
-                    .take(3)
-                    .any(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite()))
-        });
-        return Err(Error::Parse {
-            file: path.to_owned(),
+    let mut reader = Reader {
+        path,
+        positions: Vec::new(),
+        texcoord_count: 0,
+        normal_count: 0,
+        faces: Vec::new(),
+        corners: Vec::new(),
+        highest_texcoord: Highest::default(),
+        highest_normal: Highest::default(),
+        raw: RawMesh::default(),
+        stamp: Vec::new(),
+        local: Vec::new(),
+        object: 0,
+    };
+    let start = if bytes.starts_with(&[0xEF, 0xBB, 0xBF]) {
+        3
+    } else {
+        0
+    };
+    for (number, offset, line) in lines(bytes, start) {
+        if let Some(nul) = line.iter().position(|&b| b == 0) {
+            return Err(err(
+                number,
+                offset + nul as u64,
+                "a NUL byte: binary data, not OBJ text (UTF-16 without a byte-order mark \
+                 also looks like this)"
+                    .into(),
+            ));
+        }
+        let text = std::str::from_utf8(line).map_err(|e| {
+            err(
+                number,
+                offset + e.valid_up_to() as u64,
+                "not UTF-8 text: OBJ is read as UTF-8 or ASCII".into(),
+            )
+        })?;
+        let text = text.split_once('#').map_or(text, |(before, _)| before);
+        reader.statement(text, number, offset)?;
+    }
+    reader.end_object()?;
+    reader.check_attribute_ranges()?;
+    Ok(reader.raw)
+}
+
+/// The lines of `bytes` from `start` as (1-based number, byte offset,
+/// content): a line ends at `\n`, `\r\n` or a lone `\r`.
+fn lines(bytes: &[u8], start: usize) -> impl Iterator<Item = (u64, u64, &[u8])> {
+    let mut at = start;
+    let mut number = 0u64;
+    std::iter::from_fn(move || {
+        if at >= bytes.len() {
+            return None;
+        }
+        let begin = at;
+        let len = bytes[begin..]
+            .iter()
+            .position(|&b| b == b'\n' || b == b'\r')
+            .unwrap_or(bytes.len() - begin);
+        let end = begin + len;
+        at = end;
+        if at < bytes.len() {
+            at += if bytes[at] == b'\r' && bytes.get(at + 1) == Some(&b'\n') {
+                2
+            } else {
+                1
+            };
+        }
+        number += 1;
+        Some((number, begin as u64, &bytes[begin..end]))
+    })
+}
+
+impl Reader<'_> {
+    fn error(&self, line: u64, byte: u64, element: &str, message: String) -> Error {
+        let mut place = Place::line(line).at_byte(byte);
+        place.element = Some(format!("`{element}` statement"));
+        Error::Parse {
+            file: self.path.to_owned(),
             place,
-            message: "vertex coordinate is NaN or infinite".into(),
-        });
-    }
-    Ok(raw)
-}
-
-/// Finds the first line whose whitespace-separated words satisfy `bad`.
-fn find_line(bytes: &[u8], mut bad: impl FnMut(&[&str]) -> bool) -> Place {
-    let text = String::from_utf8_lossy(bytes);
-    let mut words = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        words.clear();
-        words.extend(line.split_whitespace());
-        if !words.is_empty() && bad(&words) {
-            let mut place = Place::line(i as u64 + 1);
-            place.element = Some(format!("`{}` statement", words[0]));
-            return place;
+            message,
         }
     }
-    Place::default()
-}
 
-/// Maps a `tobj` error to the line that caused it and a message.
-fn locate_error(bytes: &[u8], e: tobj::LoadError) -> (Place, String) {
-    use tobj::LoadError as E;
-    let what = e.to_string();
-    let place = match e {
-        E::PositionParseError => find_line(bytes, |w| w[0] == "v" && !floats_ok(&w[1..], 3)),
-        E::NormalParseError => find_line(bytes, |w| w[0] == "vn" && !floats_ok(&w[1..], 3)),
-        E::TexcoordParseError => find_line(bytes, |w| w[0] == "vt" && !floats_ok(&w[1..], 1)),
-        E::FaceVertexOutOfBounds | E::FaceParseError | E::InvalidPolygon => {
-            let mut v_count: i64 = 0;
-            find_line(bytes, |w| {
-                if w[0] == "v" {
-                    v_count += 1;
-                    return false;
+    fn statement(&mut self, text: &str, line: u64, byte: u64) -> Result<()> {
+        let mut words = text.split_whitespace();
+        let Some(keyword) = words.next() else {
+            return Ok(());
+        };
+        match keyword {
+            "v" => self.vertex(words, line, byte),
+            "vt" => {
+                let values = numbers(words).map_err(|w| {
+                    self.error(line, byte, "vt", format!("`{w}` is not a number"))
+                })?;
+                if !(1..=3).contains(&values) {
+                    return Err(self.error(
+                        line,
+                        byte,
+                        "vt",
+                        format!("expected 1 to 3 texture coordinates, found {values}"),
+                    ));
                 }
-                w[0] == "f" && !face_ok(&w[1..], v_count)
-            })
+                self.texcoord_count += 1;
+                Ok(())
+            }
+            "vn" => {
+                let values = numbers(words)
+                    .map_err(|w| self.error(line, byte, "vn", format!("`{w}` is not a number")))?;
+                if values != 3 {
+                    return Err(self.error(
+                        line,
+                        byte,
+                        "vn",
+                        format!("expected 3 normal coordinates, found {values}"),
+                    ));
+                }
+                self.normal_count += 1;
+                Ok(())
+            }
+            "f" => self.face(words, line, byte),
+            "o" | "g" => {
+                if !self.faces.is_empty() {
+                    self.end_object()?;
+                }
+                Ok(())
+            }
+            // Lines, points, free-form geometry, materials, smoothing groups
+            // and unknown statements carry no triangles.
+            _ => Ok(()),
         }
-        _ => Place::default(),
-    };
-    (place, what)
+    }
+
+    /// `v x y z`, `v x y z w` (divided by w) or `v x y z r g b` (colour
+    /// ignored).
+    fn vertex<'a>(
+        &mut self,
+        mut words: impl Iterator<Item = &'a str>,
+        line: u64,
+        byte: u64,
+    ) -> Result<()> {
+        let mut xyz = [0f32; 3];
+        for (k, c) in xyz.iter_mut().enumerate() {
+            let Some(w) = words.next() else {
+                return Err(self.error(
+                    line,
+                    byte,
+                    "v",
+                    format!("expected 3 coordinates x y z, found {k}"),
+                ));
+            };
+            *c = w
+                .parse()
+                .map_err(|_| self.error(line, byte, "v", format!("`{w}` is not a number")))?;
+        }
+        let rest: Vec<&str> = words.take(4).collect();
+        let mut p = Vec3::from(xyz);
+        match rest.len() {
+            0 => {}
+            1 => {
+                let w: f32 = rest[0].parse().map_err(|_| {
+                    self.error(line, byte, "v", format!("`{}` is not a number", rest[0]))
+                })?;
+                if w == 0.0 {
+                    return Err(self.error(line, byte, "v", "weight w is 0".into()));
+                }
+                p /= w;
+            }
+            3 => {
+                if let Some(w) = rest.iter().find(|w| w.parse::<f32>().is_err()) {
+                    return Err(self.error(line, byte, "v", format!("`{w}` is not a number")));
+                }
+            }
+            n => {
+                return Err(self.error(
+                    line,
+                    byte,
+                    "v",
+                    format!(
+                        "expected x y z, then nothing, a weight w or a colour r g b; found {} \
+                         values",
+                        3 + n
+                    ),
+                ))
+            }
+        }
+        if !p.is_finite() {
+            return Err(self.error(
+                line,
+                byte,
+                "v",
+                "vertex coordinate is NaN or infinite".into(),
+            ));
+        }
+        if self.positions.len() as u64 >= u64::from(u32::MAX) {
+            return Err(self.error(line, byte, "v", "more than 2^32 - 1 vertices".into()));
+        }
+        self.positions.push(p);
+        Ok(())
+    }
+
+    /// `f v v v ...` with corners `v`, `v/vt`, `v//vn` or `v/vt/vn`, indices
+    /// from 1 or negative (relative to the elements read so far).
+    fn face<'a>(&mut self, words: impl Iterator<Item = &'a str>, line: u64, byte: u64) -> Result<()> {
+        let first = self.corners.len();
+        for (k, corner) in words.enumerate() {
+            let mut parts = corner.split('/');
+            let counts = [
+                self.positions.len() as u64,
+                self.texcoord_count,
+                self.normal_count,
+            ];
+            for (slot, count) in counts.into_iter().enumerate() {
+                let Some(part) = parts.next() else { break };
+                if part.is_empty() && slot > 0 {
+                    continue;
+                }
+                let what = ["position", "texture coordinate", "normal"][slot];
+                let index: i64 = part.parse().map_err(|_| {
+                    self.error(
+                        line,
+                        byte,
+                        "f",
+                        format!(
+                            "corner {} (`{corner}`): `{part}` is not a {what} index (expected \
+                             v, v/vt, v//vn or v/vt/vn with integers)",
+                            k + 1
+                        ),
+                    )
+                })?;
+                let resolved = match index {
+                    i if i > 0 => Some(i as u64 - 1),
+                    i if i < 0 => count.checked_sub(i.unsigned_abs()),
+                    _ => None,
+                };
+                let Some(resolved) = resolved else {
+                    return Err(self.error(
+                        line,
+                        byte,
+                        "f",
+                        format!(
+                            "corner {}: {what} index {index} is out of range ({count} defined \
+                             so far; indices start at 1, negative ones count back)",
+                            k + 1
+                        ),
+                    ));
+                };
+                match slot {
+                    0 => self.corners.push(resolved),
+                    1 => self.highest_texcoord.see(resolved, line, byte),
+                    _ => self.highest_normal.see(resolved, line, byte),
+                }
+            }
+            if parts.next().is_some() {
+                return Err(self.error(
+                    line,
+                    byte,
+                    "f",
+                    format!(
+                        "corner {} (`{corner}`) has more than three parts v/vt/vn",
+                        k + 1
+                    ),
+                ));
+            }
+        }
+        if self.corners.len() - first < 3 {
+            // A point or a line written as a face: no triangle, counted.
+            self.corners.truncate(first);
+            self.raw.degenerate_in_source += 1;
+            return Ok(());
+        }
+        self.faces.push(Face {
+            line,
+            byte,
+            corners: first..self.corners.len(),
+        });
+        Ok(())
+    }
+
+    /// Numbers the current object's vertices in first-use order and
+    /// fan-triangulates its faces.
+    fn end_object(&mut self) -> Result<()> {
+        let count = self.positions.len() as u64;
+        self.object += 1;
+        if self.stamp.len() < self.positions.len() {
+            self.stamp.resize(self.positions.len(), 0);
+            self.local.resize(self.positions.len(), 0);
+        }
+        let base = self.raw.positions.len();
+        let faces = std::mem::take(&mut self.faces);
+        for face in &faces {
+            let mut ids = [0u32; 3];
+            for (k, c) in face.corners.clone().enumerate() {
+                let v = self.corners[c];
+                if v >= count {
+                    return Err(self.error(
+                        face.line,
+                        face.byte,
+                        "f",
+                        format!(
+                            "corner {}: position index {} is past the {count} vertices in the \
+                             file",
+                            k + 1,
+                            v + 1
+                        ),
+                    ));
+                }
+                let v = v as usize;
+                if self.stamp[v] != self.object {
+                    self.stamp[v] = self.object;
+                    self.local[v] = (self.raw.positions.len() - base) as u32;
+                    if self.raw.positions.len() as u64 >= u64::from(u32::MAX) {
+                        return Err(self.error(
+                            face.line,
+                            face.byte,
+                            "f",
+                            "more than 2^32 - 1 vertices".into(),
+                        ));
+                    }
+                    self.raw.positions.push(self.positions[v]);
+                }
+                let id = base as u32 + self.local[v];
+                match k {
+                    0 | 1 => ids[k] = id,
+                    _ => {
+                        if k > 2 {
+                            ids[1] = ids[2];
+                        }
+                        ids[2] = id;
+                        self.raw.triangles.push(ids);
+                    }
+                }
+            }
+        }
+        self.faces = faces;
+        self.faces.clear();
+        self.corners.clear();
+        Ok(())
+    }
+
+    /// Texture-coordinate and normal indices against the counts in the
+    /// whole file (a face may name ones defined after it, as `tobj` allowed).
+    fn check_attribute_ranges(&self) -> Result<()> {
+        for (highest, count, what) in [
+            (&self.highest_texcoord, self.texcoord_count, "texture coordinate (`vt`)"),
+            (&self.highest_normal, self.normal_count, "normal (`vn`)"),
+        ] {
+            if let Some((index, line, byte)) = highest.index {
+                if index >= count {
+                    return Err(self.error(
+                        line,
+                        byte,
+                        "f",
+                        format!(
+                            "{what} index {} is past the {count} defined in the file",
+                            index + 1
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
-fn floats_ok(words: &[&str], min: usize) -> bool {
-    words.len() >= min && words.iter().take(3).all(|w| w.parse::<f32>().is_ok())
-}
-
-/// A face statement is well formed when it has at least three corners and
-/// every position index is 1..=count (or a valid negative relative index).
-fn face_ok(corners: &[&str], vertices_so_far: i64) -> bool {
-    corners.len() >= 3
-        && corners.iter().all(|c| {
-            c.split('/')
-                .next()
-                .and_then(|s| s.parse::<i64>().ok())
-                .is_some_and(|i| {
-                    (i > 0 && i <= vertices_so_far) || (i < 0 && -i <= vertices_so_far)
-                })
-        })
+/// How many of `words` there are, or the first that is not a number.
+fn numbers<'a>(words: impl Iterator<Item = &'a str>) -> std::result::Result<usize, &'a str> {
+    let mut n = 0;
+    for w in words {
+        w.parse::<f32>().map_err(|_| w)?;
+        n += 1;
+    }
+    Ok(n)
 }
 
 #[cfg(test)]
@@ -142,6 +464,13 @@ mod tests {
 
     fn parse(text: &str) -> Result<RawMesh> {
         parse_obj(text.as_bytes(), Path::new("t.obj"))
+    }
+
+    fn place(text: &[u8]) -> Place {
+        match parse_obj(text, Path::new("t.obj")).unwrap_err() {
+            Error::Parse { place, .. } => place,
+            e => panic!("not a parse error: {e}"),
+        }
     }
 
     #[test]
@@ -155,11 +484,55 @@ mod tests {
         assert_eq!(raw.triangles, vec![[0, 1, 2], [0, 2, 3], [4, 5, 6]]);
     }
 
+    /// Vertices are numbered per object in first-use order, and one used by
+    /// two objects is listed twice (what `tobj` gave, so outputs did not
+    /// change with the reader).
+    #[test]
+    fn objects_number_vertices_in_first_use_order() {
+        let raw = parse(
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 9 9 9\ng a\nf 3 2 1\ng b\nf 1 3 4\n",
+        )
+        .unwrap();
+        let p = |x: f32, y: f32| Vec3::new(x, y, 0.0);
+        assert_eq!(
+            raw.positions,
+            vec![p(1.0, 1.0), p(1.0, 0.0), p(0.0, 0.0), p(0.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)]
+        );
+        assert_eq!(raw.triangles, vec![[0, 1, 2], [3, 4, 5]]);
+    }
+
+    #[test]
+    fn corners_with_attributes_relative_indices_and_weights() {
+        let raw = parse(
+            "v 0 0 0 2\nv 2 0 0\nv 0 2 0\nvt 0 0\nvt 1 0\nvn 0 0 1\n\
+             f 1/1/1 2/2/1 3//1\nf -3/-2 -2/-1 -1/-1\n",
+        )
+        .unwrap();
+        assert_eq!(raw.positions[0], Vec3::ZERO);
+        assert_eq!(raw.triangles, vec![[0, 1, 2], [0, 1, 2]]);
+    }
+
+    #[test]
+    fn lines_and_points_are_not_triangles() {
+        let raw = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2 3\np 1\nf 1 2 3\nf 1 2\n").unwrap();
+        assert_eq!(raw.triangles, vec![[0, 1, 2]]);
+        assert_eq!(raw.degenerate_in_source, 1, "the two-corner face is counted");
+    }
+
     #[test]
     fn out_of_range_index_names_its_line() {
         let err = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 2 9\n").unwrap_err();
         let s = err.to_string();
         assert!(s.contains("t.obj") && s.contains("line 5"), "{s}");
+        assert_eq!(place(b"v 0 0 0\nf 1 -2 1\n").line, Some(2));
+        assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n").line, Some(4));
+    }
+
+    #[test]
+    fn texture_and_normal_indices_are_checked() {
+        let p = place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1/2 2/1 3/1\n");
+        assert_eq!((p.line, p.byte), (Some(6), Some(45)));
+        assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n").line, Some(4));
     }
 
     #[test]
@@ -167,11 +540,50 @@ mod tests {
         let err = parse("v 0 0 0\nv nan 0 0\nv 1 1 0\nf 1 2 3\n").unwrap_err();
         let s = err.to_string();
         assert!(s.contains("line 2") && s.contains("NaN"), "{s}");
+        assert_eq!(place(b"v 1 1 1 0\n").line, Some(1));
     }
 
     #[test]
-    fn malformed_position_names_its_line() {
-        let err = parse("v 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n").unwrap_err();
-        assert!(err.to_string().contains("line 3"), "{err}");
+    fn malformed_statements_name_their_line() {
+        assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n").line, Some(3));
+        assert_eq!(place(b"v 0 0 0\nv 1 0\n").line, Some(2));
+        assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/a 2 3\n").line, Some(4));
+        assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n").line, Some(4));
+        assert_eq!(place(b"vn 0 0\n").line, Some(1));
+    }
+
+    #[test]
+    fn line_endings_and_encodings() {
+        let cr = parse("v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r").unwrap();
+        assert_eq!(cr.triangles.len(), 1);
+        let crlf = parse("\u{feff}v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3 # comment\r\n").unwrap();
+        assert_eq!(crlf.triangles.len(), 1);
+        assert_eq!(place(b"v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 4\r\n").line, Some(4));
+        let utf16: Vec<u8> = [0xFF, 0xFE].into_iter().chain(b"v\x000\x00".iter().copied()).collect();
+        let p = place(&utf16);
+        assert_eq!((p.line, p.byte), (Some(1), Some(0)));
+        let p = place(b"v 0 0 0\nv 1 \xC3\x28 0\n");
+        assert_eq!((p.line, p.byte), (Some(2), Some(12)));
+        let p = place(b"v 0 0 0\n\x00\x01\x02");
+        assert_eq!((p.line, p.byte), (Some(2), Some(8)));
+    }
+
+    /// A 100,000-corner polygon is read in linear time (was quadratic
+    /// through `tobj`'s triangulation).
+    #[test]
+    fn huge_polygon_is_a_fan() {
+        let n = 100_000;
+        let mut text = String::new();
+        for i in 0..n {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            text.push_str(&format!("v {} {} 0\n", a.cos(), a.sin()));
+        }
+        text.push('f');
+        for i in 1..=n {
+            text.push_str(&format!(" {i}"));
+        }
+        let raw = parse(&text).unwrap();
+        assert_eq!(raw.triangles.len(), n - 2);
+        assert_eq!(raw.triangles[n - 3], [0, n as u32 - 2, n as u32 - 1]);
     }
 }
