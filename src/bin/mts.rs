@@ -488,9 +488,12 @@ fn strips(args: &StripsArgs) -> Result<()> {
         join_ends: !args.no_join,
     };
     let (ours, ms) = median_ms(args.repeat, || stripify(&mesh, &options));
-    let (theirs, their_ms) = median_ms(args.repeat, || peers::meshopt::stripify(&mesh));
+    let skipped = peers::meshopt::refusal(&mesh);
+    let peer = skipped.is_none().then(|| {
+        let (theirs, their_ms) = median_ms(args.repeat, || peers::meshopt::stripify(&mesh));
+        StripStats::new(&theirs, their_ms)
+    });
     let mine = StripStats::new(&ours, ms);
-    let peer = StripStats::new(&theirs, their_ms);
     // The invariant, checked on every run: a wrong strip is never reported.
     if mts::strip::sorted_canonical(&ours.triangles())
         != mts::strip::sorted_canonical(&mesh.triangles)
@@ -499,7 +502,10 @@ fn strips(args: &StripsArgs) -> Result<()> {
     }
     if args.json {
         let mut v = stats_json(&mine);
-        v["meshopt"] = stats_json(&peer);
+        v["meshopt"] = peer.as_ref().map_or(serde_json::Value::Null, stats_json);
+        if let Some(why) = &skipped {
+            v["meshopt_skipped"] = json!(why);
+        }
         v["mesh"] = json!(name);
         v["vertices"] = json!(mesh.vertex_count());
         println!("{}", serde_json::to_string_pretty(&v)?);
@@ -513,7 +519,11 @@ fn strips(args: &StripsArgs) -> Result<()> {
         report.unreferenced_dropped,
         report.welded
     );
+    if let Some(why) = &skipped {
+        println!("{why}");
+    }
     println!("{:<22}{:>14}{:>14}", "", "mts", "meshopt");
+    let peer = peer.unwrap_or_default();
     let rows: [(&str, String, String); 7] = [
         (
             "triangles",
@@ -586,7 +596,11 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
     // Compare at one triangle count: ours at the target, meshoptimizer
     // asked for the same; when it stops above it, ours at its count.
     let mut peer_triangles = None;
-    if !args.no_meshopt {
+    let skipped = peers::meshopt::refusal(&mesh);
+    if let Some(why) = &skipped {
+        eprintln!("{name}: {why}");
+    }
+    if !args.no_meshopt && skipped.is_none() {
         let ((theirs, at), their_ms) =
             median_ms(1, || peers::meshopt::simplify_to_lod(&mesh, collapses, lod));
         lod = at;
@@ -948,7 +962,12 @@ fn make_source<'m>(
         Method::Pm => Box::new(ProgressiveMesh::new(mesh, c)?),
         Method::Multilevel => Box::new(MultilevelMesh::new(mesh, c)?),
         Method::Cluster => Box::new(ClusterTree::new(mesh)?),
-        Method::Discrete => Box::new(DiscreteLods::new(mesh, c.triangle_counts())),
+        Method::Discrete => {
+            if let Some(why) = peers::meshopt::refusal(mesh) {
+                bail!("the discrete LoDs are meshoptimizer's simplify: {why}");
+            }
+            Box::new(DiscreteLods::new(mesh, c.triangle_counts()))
+        }
     })
 }
 
@@ -1352,6 +1371,12 @@ fn measure_methods(
     let raw = mesh.raw_bytes_u16();
     let mut rows = Vec::new();
     for method in Method::ALL {
+        if method == Method::Discrete {
+            if let Some(why) = peers::meshopt::refusal(mesh) {
+                rows.push(json!({"method": "discrete", "skipped": why}));
+                continue;
+            }
+        }
         let t = Instant::now();
         let mut source = make_source(method, model, mesh)?;
         // The baselines start from the contraction sequence MTS recorded;
@@ -1419,6 +1444,10 @@ fn compare(args: &CompareArgs) -> Result<()> {
         "method", "build ms", "memory B", "file B", "/raw", "us lin", "us exp", "us rand"
     );
     for r in &rows {
+        if let Some(why) = r["skipped"].as_str() {
+            println!("{:<12}{why}", r["method"].as_str().unwrap_or(""));
+            continue;
+        }
         let f = |v: &serde_json::Value| v.as_f64().unwrap_or(0.0);
         println!(
             "{:<12}{:>10.1}{:>12}{:>12}{:>8.3}{:>10.1}{:>10.1}{:>10.1}",

@@ -139,7 +139,6 @@ pub fn diagonal_of(lo: Vec3, hi: Vec3) -> f64 {
 }
 
 impl Mesh {
-
     /// Checks the invariants listed on [`Mesh`].
     ///
     /// # Errors

@@ -3,7 +3,7 @@
 use super::Strips;
 
 /// What `mts strips` reports for one stripifier.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StripStats {
     /// Non-degenerate triangles drawn.
     pub triangles: usize,

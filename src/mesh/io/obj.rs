@@ -1,5 +1,6 @@
 //! Wavefront OBJ reader: `v`, `f` and the element counts of `vt`/`vn`;
-//! polygons fan-triangulated, all objects and groups merged, lines (`l`),
+//! polygons triangulated by [`super::triangulate_polygon`] (quads as the
+//! fan `tobj` made), all objects and groups merged, lines (`l`),
 //! points (`p`), materials and everything else ignored.
 //!
 //! An own reader rather than `tobj` (used until 2026-12): every error names
@@ -175,9 +176,8 @@ impl Reader<'_> {
         match keyword {
             "v" => self.vertex(words, line, byte),
             "vt" => {
-                let values = numbers(words).map_err(|w| {
-                    self.error(line, byte, "vt", format!("`{w}` is not a number"))
-                })?;
+                let values = numbers(words)
+                    .map_err(|w| self.error(line, byte, "vt", format!("`{w}` is not a number")))?;
                 if !(1..=3).contains(&values) {
                     return Err(self.error(
                         line,
@@ -286,7 +286,12 @@ impl Reader<'_> {
 
     /// `f v v v ...` with corners `v`, `v/vt`, `v//vn` or `v/vt/vn`, indices
     /// from 1 or negative (relative to the elements read so far).
-    fn face<'a>(&mut self, words: impl Iterator<Item = &'a str>, line: u64, byte: u64) -> Result<()> {
+    fn face<'a>(
+        &mut self,
+        words: impl Iterator<Item = &'a str>,
+        line: u64,
+        byte: u64,
+    ) -> Result<()> {
         let first = self.corners.len();
         for (k, corner) in words.enumerate() {
             let mut parts = corner.split('/');
@@ -363,7 +368,7 @@ impl Reader<'_> {
     }
 
     /// Numbers the current object's vertices in first-use order and
-    /// fan-triangulates its faces.
+    /// triangulates its faces.
     fn end_object(&mut self) -> Result<()> {
         let count = self.positions.len() as u64;
         self.object += 1;
@@ -373,8 +378,9 @@ impl Reader<'_> {
         }
         let base = self.raw.positions.len();
         let faces = std::mem::take(&mut self.faces);
+        let mut ids = Vec::new();
         for face in &faces {
-            let mut ids = [0u32; 3];
+            ids.clear();
             for (k, c) in face.corners.clone().enumerate() {
                 let v = self.corners[c];
                 if v >= count {
@@ -404,18 +410,9 @@ impl Reader<'_> {
                     }
                     self.raw.positions.push(self.positions[v]);
                 }
-                let id = base as u32 + self.local[v];
-                match k {
-                    0 | 1 => ids[k] = id,
-                    _ => {
-                        if k > 2 {
-                            ids[1] = ids[2];
-                        }
-                        ids[2] = id;
-                        self.raw.triangles.push(ids);
-                    }
-                }
+                ids.push(base as u32 + self.local[v]);
             }
+            super::triangulate_polygon(&ids, &mut self.raw.triangles);
         }
         self.faces = faces;
         self.faces.clear();
@@ -427,7 +424,11 @@ impl Reader<'_> {
     /// whole file (a face may name ones defined after it, as `tobj` allowed).
     fn check_attribute_ranges(&self) -> Result<()> {
         for (highest, count, what) in [
-            (&self.highest_texcoord, self.texcoord_count, "texture coordinate (`vt`)"),
+            (
+                &self.highest_texcoord,
+                self.texcoord_count,
+                "texture coordinate (`vt`)",
+            ),
             (&self.highest_normal, self.normal_count, "normal (`vn`)"),
         ] {
             if let Some((index, line, byte)) = highest.index {
@@ -489,14 +490,20 @@ mod tests {
     /// change with the reader).
     #[test]
     fn objects_number_vertices_in_first_use_order() {
-        let raw = parse(
-            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 9 9 9\ng a\nf 3 2 1\ng b\nf 1 3 4\n",
-        )
-        .unwrap();
+        let raw =
+            parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 9 9 9\ng a\nf 3 2 1\ng b\nf 1 3 4\n")
+                .unwrap();
         let p = |x: f32, y: f32| Vec3::new(x, y, 0.0);
         assert_eq!(
             raw.positions,
-            vec![p(1.0, 1.0), p(1.0, 0.0), p(0.0, 0.0), p(0.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)]
+            vec![
+                p(1.0, 1.0),
+                p(1.0, 0.0),
+                p(0.0, 0.0),
+                p(0.0, 0.0),
+                p(1.0, 1.0),
+                p(0.0, 1.0)
+            ]
         );
         assert_eq!(raw.triangles, vec![[0, 1, 2], [3, 4, 5]]);
     }
@@ -516,7 +523,10 @@ mod tests {
     fn lines_and_points_are_not_triangles() {
         let raw = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2 3\np 1\nf 1 2 3\nf 1 2\n").unwrap();
         assert_eq!(raw.triangles, vec![[0, 1, 2]]);
-        assert_eq!(raw.degenerate_in_source, 1, "the two-corner face is counted");
+        assert_eq!(
+            raw.degenerate_in_source, 1,
+            "the two-corner face is counted"
+        );
     }
 
     #[test]
@@ -532,7 +542,10 @@ mod tests {
     fn texture_and_normal_indices_are_checked() {
         let p = place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1/2 2/1 3/1\n");
         assert_eq!((p.line, p.byte), (Some(6), Some(45)));
-        assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n").line, Some(4));
+        assert_eq!(
+            place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n").line,
+            Some(4)
+        );
     }
 
     #[test]
@@ -547,8 +560,14 @@ mod tests {
     fn malformed_statements_name_their_line() {
         assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n").line, Some(3));
         assert_eq!(place(b"v 0 0 0\nv 1 0\n").line, Some(2));
-        assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/a 2 3\n").line, Some(4));
-        assert_eq!(place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n").line, Some(4));
+        assert_eq!(
+            place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/a 2 3\n").line,
+            Some(4)
+        );
+        assert_eq!(
+            place(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1/1 2 3\n").line,
+            Some(4)
+        );
         assert_eq!(place(b"vn 0 0\n").line, Some(1));
     }
 
@@ -558,8 +577,14 @@ mod tests {
         assert_eq!(cr.triangles.len(), 1);
         let crlf = parse("\u{feff}v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3 # comment\r\n").unwrap();
         assert_eq!(crlf.triangles.len(), 1);
-        assert_eq!(place(b"v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 4\r\n").line, Some(4));
-        let utf16: Vec<u8> = [0xFF, 0xFE].into_iter().chain(b"v\x000\x00".iter().copied()).collect();
+        assert_eq!(
+            place(b"v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 4\r\n").line,
+            Some(4)
+        );
+        let utf16: Vec<u8> = [0xFF, 0xFE]
+            .into_iter()
+            .chain(b"v\x000\x00".iter().copied())
+            .collect();
         let p = place(&utf16);
         assert_eq!((p.line, p.byte), (Some(1), Some(0)));
         let p = place(b"v 0 0 0\nv 1 \xC3\x28 0\n");
@@ -568,10 +593,10 @@ mod tests {
         assert_eq!((p.line, p.byte), (Some(2), Some(8)));
     }
 
-    /// A 100,000-corner polygon is read in linear time (was quadratic
-    /// through `tobj`'s triangulation).
+    /// A 100,000-corner polygon is read in linear time and cut as a
+    /// zigzag: no vertex in more than 4 triangles.
     #[test]
-    fn huge_polygon_is_a_fan() {
+    fn huge_polygon_is_a_zigzag() {
         let n = 100_000;
         let mut text = String::new();
         for i in 0..n {
@@ -584,6 +609,17 @@ mod tests {
         }
         let raw = parse(&text).unwrap();
         assert_eq!(raw.triangles.len(), n - 2);
-        assert_eq!(raw.triangles[n - 3], [0, n as u32 - 2, n as u32 - 1]);
+        let top = n as u32 - 1;
+        assert_eq!(
+            raw.triangles[..3],
+            [[0, 1, top], [1, top - 1, top], [1, 2, top - 1]]
+        );
+        let mut valence = vec![0; n];
+        for t in &raw.triangles {
+            for &v in t {
+                valence[v as usize] += 1;
+            }
+        }
+        assert_eq!(valence.iter().max(), Some(&4));
     }
 }

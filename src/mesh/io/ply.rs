@@ -543,24 +543,23 @@ fn read_element(
             if is_strip {
                 push_strip(&list, &mut run, raw);
             } else {
-                push_polygon(&list, raw);
+                push_polygon(&list, &mut run, raw);
             }
         }
     }
     Ok(())
 }
 
-/// Fan-triangulates one polygon; fewer than three corners count as one
-/// dropped degenerate.
-fn push_polygon(corners: &[i64], raw: &mut RawMesh) {
+/// Triangulates one polygon ([`super::triangulate_polygon`]); fewer than
+/// three corners count as one dropped degenerate. `ids` is scratch.
+fn push_polygon(corners: &[i64], ids: &mut Vec<u32>, raw: &mut RawMesh) {
     if corners.len() < 3 {
         raw.degenerate_in_source += 1;
         return;
     }
-    let c = |i: usize| corners[i] as u32;
-    for i in 1..corners.len() - 1 {
-        raw.triangles.push([c(0), c(i), c(i + 1)]);
-    }
+    ids.clear();
+    ids.extend(corners.iter().map(|&c| c as u32));
+    super::triangulate_polygon(ids, &mut raw.triangles);
 }
 
 /// Decodes one `tristrips` list: runs split at `-1`, each decoded by the
