@@ -263,7 +263,8 @@ struct BuildArgs {
     json: bool,
     /// Start a new band of strips when they send this much more indices per
     /// triangle than at the band's start (see BuildOptions::band_slack).
-    #[arg(long, default_value_t = mts::model::DEFAULT_BAND_SLACK)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = mts::model::DEFAULT_BAND_SLACK,
+          value_parser = band_slack)]
     band_slack: f64,
     /// One band only: the paper's model, whose strips degrade as the mesh
     /// is simplified.
@@ -375,8 +376,8 @@ struct StripsArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
-    /// Timed repetitions; the median is reported.
-    #[arg(long, default_value_t = 5)]
+    /// Timed repetitions (1 to 10,000); the median is reported.
+    #[arg(long, default_value_t = 5, value_parser = count_in::<1, MAX_REPEAT>, allow_negative_numbers = true)]
     repeat: usize,
     /// Skip the global quadrilateral-patch pass.
     #[arg(long)]
@@ -398,10 +399,10 @@ struct SimplifyArgs {
     #[command(flatten)]
     source: MeshSource,
     /// Keep this share of the triangles (0..1).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     ratio: Option<f64>,
     /// Keep at most this many triangles.
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     triangles: Option<usize>,
     /// Write the simplified mesh as OBJ.
     #[arg(short, long)]
@@ -414,13 +415,13 @@ struct SimplifyArgs {
     #[arg(long)]
     optimal: bool,
     /// Also contract vertex pairs closer than this share of the diagonal.
-    #[arg(long, value_name = "SHARE")]
+    #[arg(allow_negative_numbers = true, long, value_name = "SHARE", value_parser = non_negative::<f32>)]
     pair_distance: Option<f32>,
     /// Weight of the boundary-preserving planes.
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long, value_parser = non_negative::<f64>)]
     boundary_weight: Option<f64>,
     /// Surface samples per side for the error measurement.
-    #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES)]
+    #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES, value_parser = count_in::<1, MAX_SAMPLES>, allow_negative_numbers = true)]
     samples: usize,
     /// Skip meshoptimizer.
     #[arg(long)]
@@ -434,7 +435,7 @@ struct DistanceArgs {
     /// The mesh measured against it.
     other: PathBuf,
     /// Surface samples per side.
-    #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES)]
+    #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES, value_parser = count_in::<1, MAX_SAMPLES>, allow_negative_numbers = true)]
     samples: usize,
     /// Print JSON.
     #[arg(long)]
@@ -449,6 +450,63 @@ struct ConvertArgs {
     #[arg(short, long)]
     output: PathBuf,
 }
+
+/// A count argument in `MIN..=MAX`: what clap calls for `--repeat`,
+/// `--samples`, `--requests`, `--frames` and `--scene`, so that no
+/// allocation or loop is sized by an absurd number, and a negative or
+/// fractional one is named as such.
+pub(crate) fn count_in<const MIN: u64, const MAX: u64>(
+    s: &str,
+) -> std::result::Result<usize, String> {
+    let n: i128 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a whole number (expected {MIN} to {MAX})"))?;
+    if n < i128::from(MIN) || n > i128::from(MAX) {
+        return Err(format!("{n} is outside {MIN}..={MAX}"));
+    }
+    Ok(n as usize)
+}
+
+/// `--band-slack`: a number of at least [`mts::model::MIN_BAND_SLACK`]
+/// (`inf` is one band, as `--single-band`).
+fn band_slack(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if v >= mts::model::MIN_BAND_SLACK {
+        Ok(v)
+    } else {
+        Err(format!(
+            "{v} is below the smallest slack, {} (use --single-band for one band)",
+            mts::model::MIN_BAND_SLACK
+        ))
+    }
+}
+
+/// A finite number of at least 0 (weights and distances).
+fn non_negative<T: std::str::FromStr + Into<f64> + Copy>(
+    s: &str,
+) -> std::result::Result<T, String> {
+    let v: T = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    let x: f64 = v.into();
+    if x.is_finite() && x >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{x} is not a finite number of at least 0"))
+    }
+}
+
+/// Most timed repetitions `--repeat` takes.
+const MAX_REPEAT: u64 = 10_000;
+/// Most surface samples per side `--samples` takes (about 1 GB of points).
+const MAX_SAMPLES: u64 = 20_000_000;
+/// Most requests per sequence `compare --requests` takes.
+const MAX_REQUESTS: u64 = 10_000_000;
 
 fn median_ms<T>(repeat: usize, mut f: impl FnMut() -> T) -> (T, f64) {
     let mut times = Vec::with_capacity(repeat.max(1));
@@ -567,7 +625,8 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
     let target = match (args.triangles, args.ratio) {
         (Some(n), _) => n,
         (None, Some(r)) if (0.0..=1.0).contains(&r) => (r * input as f64).round() as usize,
-        (None, r) => bail!("--ratio must be between 0 and 1, not {r:?}"),
+        (None, Some(r)) => bail!("--ratio must be between 0 and 1, not {r}"),
+        (None, None) => bail!("give --ratio or --triangles"),
     };
     let defaults = SimplifyOptions::default();
     let mut options = SimplifyOptions {
@@ -853,13 +912,13 @@ fn build_with_bar(
 #[command(group(clap::ArgGroup::new("level").args(["lod", "triangles", "ratio"])))]
 struct LevelArgs {
     /// The LoD (0 is the full mesh; clamped to the last).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     lod: Option<usize>,
     /// The finest LoD with at most this many triangles.
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     triangles: Option<usize>,
     /// The LoD with this share of the full triangle count (0..1).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     ratio: Option<f64>,
 }
 
@@ -911,8 +970,8 @@ struct ExtractArgs {
     /// Write the extracted triangles as OBJ.
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Timed extractions from scratch; the median is reported.
-    #[arg(long, default_value_t = 11)]
+    /// Timed extractions from scratch (1 to 10,000); the median is reported.
+    #[arg(long, default_value_t = 11, value_parser = count_in::<1, MAX_REPEAT>, allow_negative_numbers = true)]
     repeat: usize,
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -1036,8 +1095,9 @@ fn extract(args: &ExtractArgs) -> Result<()> {
 struct VerifyArgs {
     #[command(flatten)]
     source: MeshSource,
-    /// `all`, or a number of LoDs spread evenly from 0 to the last.
-    #[arg(long, default_value = "all")]
+    /// `all`, or a number of LoDs (at least 1) spread evenly from 0 to the
+    /// last; a number above the model's LoD count checks them all.
+    #[arg(long, default_value = "all", allow_negative_numbers = true)]
     lods: String,
     /// Print JSON instead of a sentence.
     #[arg(long)]
@@ -1048,10 +1108,17 @@ fn verify(args: &VerifyArgs) -> Result<bool> {
     let (name, model) = args.source.model()?;
     let n = match args.lods.as_str() {
         "all" => None,
-        text => Some(
-            text.parse::<usize>()
-                .with_context(|| format!("--lods takes `all` or a number, not `{text}`"))?,
-        ),
+        text => {
+            let n: u128 = text.trim().parse().map_err(|_| {
+                anyhow::anyhow!("--lods takes `all` or a whole number of at least 1, not `{text}`")
+            })?;
+            if n == 0 {
+                bail!("--lods 0 checks nothing: give `all` or at least 1");
+            }
+            // More than the model has is all of them.
+            let all = model.max_lod() as u128 + 1;
+            (n < all).then_some(n as usize)
+        }
     };
     let lods = mts::model::spread_lods(model.max_lod(), n);
     let t = Instant::now();
@@ -1285,7 +1352,7 @@ struct DecodeArgs {
     /// The stream file.
     stream: PathBuf,
     /// Decode only the first N bytes (the packets they hold completely).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     bytes: Option<usize>,
     /// Write the decoded mesh as OBJ.
     #[arg(short, long)]
@@ -1297,13 +1364,14 @@ struct DecodeArgs {
 
 fn decode(args: &DecodeArgs) -> Result<()> {
     use mts::baselines::cluster::stream;
-    let all = std::fs::read(&args.stream)
-        .with_context(|| format!("cannot read {}", args.stream.display()))?;
+    let all = mts::mesh::io::read_file(&args.stream)?;
     let file = args.stream.display().to_string();
     let t = Instant::now();
+    // A prefix shorter than the file is decoded as far as it goes; the
+    // whole file is decoded strictly (checksum and all) however it was asked.
     let d = match args.bytes {
-        Some(n) => stream::decode_prefix(&all[..n.min(all.len())], &file)?,
-        None => stream::decode(&all, &file)?,
+        Some(n) if n < all.len() => stream::decode_prefix(&all[..n], &file)?,
+        _ => stream::decode(&all, &file)?,
     };
     let ms = t.elapsed().as_secs_f64() * 1e3;
     let mesh = d.mesh();
@@ -1348,8 +1416,9 @@ fn decode(args: &DecodeArgs) -> Result<()> {
 struct CompareArgs {
     #[command(flatten)]
     source: MeshSource,
-    /// Requests in each sequence (linear, exponential, random).
-    #[arg(long, default_value_t = 100)]
+    /// Requests in each sequence (linear, exponential, random; 1 to 10
+    /// million).
+    #[arg(long, default_value_t = 100, value_parser = count_in::<1, MAX_REQUESTS>, allow_negative_numbers = true)]
     requests: usize,
     /// Print JSON instead of a table.
     #[arg(long)]

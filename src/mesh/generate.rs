@@ -227,8 +227,10 @@ pub enum GeneratedKind {
     Grid,
 }
 
-/// Largest triangle count a [`Generated`] accepts (about 2^30).
-pub const MAX_GENERATED_TRIANGLES: u64 = 1 << 30;
+/// Largest triangle count a [`Generated`] accepts: 2^24, about 16.8
+/// million. The mesh alone is then about 300 MB and its model several GB;
+/// 2^30 was accepted before and ran out of memory in the generator.
+pub const MAX_GENERATED_TRIANGLES: u64 = 1 << 24;
 
 impl Generated {
     /// The default built-in mesh: a 100K-triangle noisy icosphere.
@@ -291,7 +293,9 @@ impl FromStr for Generated {
         let value: f64 = digits.parse().map_err(|_| bad("size is not a number"))?;
         let triangles = value * scale;
         if !(1.0..=MAX_GENERATED_TRIANGLES as f64).contains(&triangles) {
-            return Err(bad("size must be between 1 and 2^30 triangles"));
+            return Err(bad(&format!(
+                "size must be between 1 and {MAX_GENERATED_TRIANGLES} (16.8M) triangles"
+            )));
         }
         Ok(Generated {
             kind,

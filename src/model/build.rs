@@ -152,6 +152,17 @@ pub fn build_with_progress(
     let max_lod = collapses.max_lod() as u32;
     let mut positions = mesh.positions.clone();
     positions.extend_from_slice(collapses.appended());
+    // The slack the bands use is the one the model records, so that its
+    // file loads again: NaN or below MIN_BAND_SLACK means MIN_BAND_SLACK.
+    let effective = BuildOptions {
+        band_slack: if options.band_slack >= MIN_BAND_SLACK {
+            options.band_slack
+        } else {
+            MIN_BAND_SLACK
+        },
+        ..options.clone()
+    };
+    let options = &effective;
     let ctx = Context {
         // Bands are stripified from the strips' own triangles, so that a
         // model built again from its file (which stores the strips) is the
@@ -163,7 +174,7 @@ pub fn build_with_progress(
         positions,
         collapses,
         options,
-        slack: options.band_slack.max(MIN_BAND_SLACK),
+        slack: options.band_slack,
         max_lod,
     };
     let starts = ctx.segment_starts();

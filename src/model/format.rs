@@ -128,10 +128,7 @@ impl MtsModel {
     /// [`Error::Io`] if the file cannot be read; otherwise as
     /// [`MtsModel::from_bytes`].
     pub fn load(path: &Path) -> Result<MtsModel> {
-        let bytes = std::fs::read(path).map_err(|source| Error::Io {
-            file: path.to_owned(),
-            source,
-        })?;
+        let bytes = crate::mesh::io::read_file(path)?;
         MtsModel::from_bytes(&bytes, path)
     }
 

@@ -131,9 +131,17 @@ impl HeadlessTarget {
         );
         let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let padded_row = (4 * width).div_ceil(align) * align;
+        let readback = u64::from(padded_row) * u64::from(height);
+        let max_buffer = device.limits().max_buffer_size;
+        if readback > max_buffer {
+            return Err(Error::InvalidArgument(format!(
+                "image size {width}x{height} needs a {readback}-byte readback buffer, above the \
+                 device's max_buffer_size {max_buffer}"
+            )));
+        }
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mts readback"),
-            size: u64::from(padded_row) * u64::from(height),
+            size: readback,
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });

@@ -15,12 +15,15 @@
 //! slot index of all bands) and a GPU region of the widest band; a model
 //! of a few thousand triangles costs well under 1 MB per instance, the
 //! 70K-triangle bunny several MB (see [`InstancedScene::bytes_per_instance`]).
-//! The scene needs primitive restart ([`StripMode::Restart`]).
+//! On a backend that ignores primitive restart ([`StripMode::Stitched`],
+//! wgpu's GL) each region holds the instance's runs stitched with
+//! degenerate triangles, rewritten whole when its LoD changes.
 
 use super::camera::Camera;
 use super::gpu::StripMode;
 use super::strip_renderer::{write_index_range, RendererConfig, StripRenderer, INSTANCE_BYTES};
 use crate::model::Extractor;
+use crate::strip::encode::stitch_restart_buffer;
 use crate::{Error, MtsModel, Result};
 use glam::{Mat4, Vec3, Vec4};
 use std::ops::Range;
@@ -90,7 +93,19 @@ pub struct InstancedScene<'m> {
     /// Extent of the field: min and max corner on the ground.
     field: (Vec3, Vec3),
     scratch: Vec<u16>,
+    /// The backend ignores primitive restart: each instance's region holds
+    /// its active range stitched with degenerate triangles, written whole
+    /// on every LoD change.
+    stitched: bool,
+    stitch_scratch: Vec<u32>,
 }
+
+/// Most instances an [`InstancedScene`] takes.
+pub const MAX_INSTANCES: usize = 1 << 20;
+
+/// Most bytes of per-instance coherence caches an [`InstancedScene`]
+/// holds (2 GiB).
+pub const MAX_CACHE_BYTES: usize = 2 << 30;
 
 impl<'m> InstancedScene<'m> {
     /// Places `count` instances of `model` on a square grid on the plane
@@ -99,9 +114,11 @@ impl<'m> InstancedScene<'m> {
     /// them.
     ///
     /// # Errors
-    /// [`Error::InvalidArgument`] for `count == 0` or a strip mode other
-    /// than [`StripMode::Restart`]; [`Error::Gpu`] when the index buffer
-    /// (`count` × the widest band) exceeds the device's `max_buffer_size`.
+    /// [`Error::InvalidArgument`] for a `count` outside 1..=[`MAX_INSTANCES`],
+    /// caches above [`MAX_CACHE_BYTES`] or a model too large for the field
+    /// in `f32`; [`Error::Gpu`] when the index buffer (`count` × the widest
+    /// band) exceeds the device's `max_buffer_size`. Nothing large is
+    /// allocated before these checks.
     ///
     /// Cost: one extractor per instance (O(strips) each), no extraction.
     pub fn new(
@@ -111,20 +128,33 @@ impl<'m> InstancedScene<'m> {
         model: &'m MtsModel,
         count: usize,
     ) -> Result<InstancedScene<'m>> {
-        if count == 0 {
-            return Err(Error::InvalidArgument("a scene needs instances".into()));
-        }
-        if config.strip_mode != StripMode::Restart {
+        if count == 0 || count > MAX_INSTANCES {
             return Err(Error::InvalidArgument(format!(
-                "the instanced scene needs primitive restart, not {}",
-                config.strip_mode
+                "a scene holds 1 to {MAX_INSTANCES} instances, not {count}"
+            )));
+        }
+        // Per instance: the extractor's slot buffer on the CPU; refused
+        // before anything is allocated.
+        let cpu_per_instance = 4 * Extractor::new(model).buffer().len();
+        let cpu = cpu_per_instance.saturating_mul(count);
+        if cpu > MAX_CACHE_BYTES {
+            return Err(Error::InvalidArgument(format!(
+                "{count} instances would hold {cpu} bytes of coherence caches ({cpu_per_instance} \
+                 each), above {MAX_CACHE_BYTES}; use fewer instances"
+            )));
+        }
+        let stitched = config.strip_mode == StripMode::Stitched;
+        let (min, max) = crate::mesh::bounds_of(model.positions()).unwrap_or_default();
+        let radius = ((crate::mesh::diagonal_of(min, max) * 0.5) as f32).max(f32::MIN_POSITIVE);
+        let spacing = 5.0 * radius;
+        let side = (count as f64).sqrt().ceil() as usize;
+        if !(spacing * (side as f32 + 3.0) + max.abs().max_element()).is_finite() {
+            return Err(Error::InvalidArgument(format!(
+                "a model {radius:e} units across does not fit a field of {count} instances in \
+                 f32 coordinates"
             )));
         }
         let renderer = StripRenderer::for_model(device, queue, config, model)?;
-        let (min, max) = crate::mesh::bounds_of(model.positions()).unwrap_or_default();
-        let radius = ((max - min).length() * 0.5).max(f32::MIN_POSITIVE);
-        let spacing = 5.0 * radius;
-        let side = (count as f64).sqrt().ceil() as usize;
         let mut instances = Vec::with_capacity(count);
         let local_centre = (min + max) * 0.5;
         for i in 0..count {
@@ -170,13 +200,22 @@ impl<'m> InstancedScene<'m> {
             .max()
             .unwrap_or(0);
         drop(probe);
-        let extractors: Vec<Extractor<'m>> = (0..count).map(|_| Extractor::new(model)).collect();
-        let region = (widest + 1) & !1;
+        // Stitching turns each restart into at most three repeated indices
+        // and runs hold at least four entries with their restart, so twice
+        // the widest active range holds any stitched one (and the padding
+        // index a 16-bit write may add).
+        let region = if stitched {
+            2 * widest + 4
+        } else {
+            (widest + 1) & !1
+        };
         let index_size = match renderer.index_format() {
             wgpu::IndexFormat::Uint16 => 2,
             wgpu::IndexFormat::Uint32 => 4,
         };
-        let bytes = (count * region.max(2) * index_size) as u64;
+        let bytes = (count as u64)
+            .saturating_mul(region.max(2) as u64)
+            .saturating_mul(index_size);
         let max = device.limits().max_buffer_size;
         if bytes > max {
             return Err(Error::Gpu(format!(
@@ -184,6 +223,7 @@ impl<'m> InstancedScene<'m> {
                  max_buffer_size {max}; use fewer instances or a smaller model"
             )));
         }
+        let extractors: Vec<Extractor<'m>> = (0..count).map(|_| Extractor::new(model)).collect();
         let index_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mts scene indices"),
             size: bytes,
@@ -203,6 +243,8 @@ impl<'m> InstancedScene<'m> {
         queue.write_buffer(&instance_buffer, 0, bytemuck::cast_slice(&transforms));
         let bvh = instance_bvh(&instances);
         Ok(InstancedScene {
+            stitched,
+            stitch_scratch: Vec::new(),
             model,
             renderer,
             ground,
@@ -306,7 +348,24 @@ impl<'m> InstancedScene<'m> {
             let budget = (std::f32::consts::PI * r_px * r_px / PIXELS_PER_TRIANGLE) as usize;
             let lod = self.model.lod_for_triangles(budget.max(1));
             let ex = &mut self.extractors[i];
-            if ex.lod() != Some(lod) {
+            if ex.lod() != Some(lod) && self.stitched {
+                ex.set_lod(lod);
+                stats.lod_changes += 1;
+                stitch_restart_buffer(&ex.buffer()[ex.active_range()], &mut self.stitch_scratch);
+                let n = self.stitch_scratch.len();
+                self.held[i] = 0..n;
+                if n > 0 {
+                    stats.upload_bytes += write_index_range(
+                        queue,
+                        &self.index_buffer,
+                        self.renderer.index_format(),
+                        &self.stitch_scratch,
+                        0..n,
+                        i * self.region,
+                        &mut self.scratch,
+                    );
+                }
+            } else if ex.lod() != Some(lod) {
                 ex.set_lod(lod);
                 stats.lod_changes += 1;
                 stats.upload_bytes += upload_instance(
@@ -320,7 +379,11 @@ impl<'m> InstancedScene<'m> {
                 );
             }
             stats.triangles += self.model.triangle_count(lod);
-            stats.indices_sent += ex.indices_sent();
+            stats.indices_sent += if self.stitched {
+                self.held[i].len()
+            } else {
+                ex.indices_sent()
+            };
             stats.indices_drawn += self.held[i].len();
         }
         stats.visible = self.visible.len();

@@ -315,7 +315,7 @@ impl<'m> State<'m> {
                 (drawn, (lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-6))
             }
             ViewerContent::Scene(n) => {
-                // Needs primitive restart: on GL this is a clear error.
+                // Stitched on backends that ignore primitive restart.
                 let scene = InstancedScene::new(&device, &queue, &renderer_config, model, n)?;
                 let (lo, hi) = scene.instances().iter().fold(
                     (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),

@@ -212,7 +212,17 @@ fn decode_with(bytes: &[u8], file: &str, strict: bool) -> Result<Decoded> {
         u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]) as usize
     };
     let (n, t, roots, base, checksum) = (word(0), word(1), word(2), word(3), word(4) as u32);
-    if roots > n || (n > 0 && roots == 0) || base > t {
+    if n < 3 || t == 0 {
+        return Err(header_error(
+            file,
+            8,
+            format!(
+                "{n} vertices and {t} triangles: a stream encodes a mesh of at least one \
+                 triangle"
+            ),
+        ));
+    }
+    if roots > n || roots == 0 || base > t {
         return Err(header_error(
             file,
             8,

@@ -17,14 +17,18 @@ pub struct BenchRenderArgs {
     /// An .mts model, or an OBJ/PLY mesh (the model is built on the fly).
     #[command(flatten)]
     source: MeshSource,
-    /// Frames timed per method and level (after two warm-up frames).
-    #[arg(long, default_value_t = 30)]
+    /// Frames timed per method and level (after two warm-up frames; 1 to
+    /// 100,000).
+    #[arg(long, default_value_t = 30, allow_negative_numbers = true,
+          value_parser = crate::count_in::<1, 100_000>)]
     frames: usize,
     /// Image size in pixels.
     #[arg(long, default_value = "1024x768")]
     size: Size,
-    /// Instances of the model in the scene row (0 to skip it).
-    #[arg(long, default_value_t = 1000)]
+    /// Instances of the model in the scene row (0 to skip it; at most
+    /// 2^20).
+    #[arg(long, default_value_t = 1000, allow_negative_numbers = true,
+          value_parser = crate::count_in::<0, { 1 << 20 }>)]
     scene: usize,
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -211,7 +215,7 @@ pub fn scene_row(
 ) -> Result<Option<serde_json::Value>> {
     use mts::render::InstancedScene;
     let per_instance = 4 * Extractor::new(model).buffer().len();
-    if per_instance * instances > SCENE_MEMORY_CAP {
+    if per_instance.saturating_mul(instances) > SCENE_MEMORY_CAP {
         eprintln!(
             "scene skipped: {instances} instances would hold {:.1} GB of coherence caches \
              ({per_instance} bytes each); pass a smaller --scene",
@@ -219,7 +223,6 @@ pub fn scene_row(
         );
         return Ok(None);
     }
-    // The scene needs primitive restart: on GL this is a clear error.
     let mut scene = InstancedScene::new(&gpu.device, &gpu.queue, config, model, instances)?;
     let camera = scene.overview_camera(target.aspect());
     let (width, height) = target.size();

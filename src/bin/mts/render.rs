@@ -98,7 +98,8 @@ pub struct RenderArgs {
     /// Draw N instances of the model on a ground plane instead (each with
     /// its own LoD from its projected size; 1000 when N is left out).
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
-          conflicts_with_all = ["lod", "triangles", "ratio", "method"])]
+          conflicts_with_all = ["lod", "triangles", "ratio", "method"],
+          allow_negative_numbers = true, value_parser = crate::count_in::<1, { 1 << 20 }>)]
     scene: Option<usize>,
 }
 
@@ -224,7 +225,6 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     let Size(width, height) = args.size;
     let gpu = Gpu::new_headless()?;
     let report = gpu.report();
-    // The scene needs primitive restart: on GL this is a clear error.
     let config = RendererConfig::headless(report.strip_mode);
     let (device, queue) = (&gpu.device, &gpu.queue);
     let target = HeadlessTarget::new(device, width, height)?;

@@ -105,26 +105,49 @@ pub struct LoadOptions {
     pub clean: CleanOptions,
 }
 
-/// Reads a whole file into memory, refusing files over [`MAX_FILE_BYTES`].
+/// Reads a whole file into memory, refusing files over [`MAX_FILE_BYTES`]
+/// and anything that is not a regular file (a device such as `/dev/zero`
+/// or a pipe reports no size and may never end). Never reads past
+/// [`MAX_FILE_BYTES`], whatever the file's size turns out to be.
 ///
 /// # Errors
-/// [`Error::Io`] when the file cannot be read, [`Error::Parse`] when too large.
+/// [`Error::Io`] when the file cannot be read, [`Error::Parse`] when it is
+/// too large or not a regular file.
 pub fn read_file(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read;
     let io = |source| Error::Io {
         file: path.to_owned(),
         source,
     };
-    let len = std::fs::metadata(path).map_err(io)?.len();
-    if len > MAX_FILE_BYTES {
-        return Err(Error::Parse {
-            file: path.to_owned(),
-            place: crate::Place::default(),
-            message: format!(
-                "file is {len} bytes, more than the {MAX_FILE_BYTES} this reader accepts"
-            ),
-        });
+    let refuse = |message: String| Error::Parse {
+        file: path.to_owned(),
+        place: crate::Place::default(),
+        message,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if !meta.is_file() {
+        return Err(refuse(
+            "not a regular file (a directory, device or pipe): inputs are read whole from files"
+                .into(),
+        ));
     }
-    std::fs::read(path).map_err(io)
+    let len = meta.len();
+    if len > MAX_FILE_BYTES {
+        return Err(refuse(format!(
+            "file is {len} bytes, more than the {MAX_FILE_BYTES} this reader accepts"
+        )));
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(refuse(format!(
+            "file grew past the {MAX_FILE_BYTES} bytes this reader accepts while it was read"
+        )));
+    }
+    Ok(bytes)
 }
 
 /// Parses mesh bytes in the given format; `path` names the input in errors.
