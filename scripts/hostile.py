@@ -13,14 +13,15 @@ render run; well under 2 minutes on 2 cores with a sound binary)::
 
     python3 scripts/hostile.py --mts target/release/mts --quick
 
-Full run (default: seed 1, 2,700 inputs, about 7,000 runs, --jobs 2)::
+Full run (default: seed 1, 2,700 inputs, about 7,600 runs, --jobs 2; under
+2 minutes on 2 cores with a sound binary, each hang adds up to --timeout)::
 
     python3 scripts/hostile.py --mts target/release/mts --json hostile.json --keep hostile-cases
 
 Other options: --seed N, --count N (inputs), --timeout S (20), --mem-gb G (4),
 --families obj,ply,mts,stream,args,extreme, --jobs N (2), --list-limit N.
-The same seed and count give the same inputs whatever --jobs or --families
-say (each input is drawn from its own generator, seeded by seed and index).
+The same seed, count and --families give the same inputs whatever --jobs
+says (each input is drawn from its own generator, seeded by seed and index).
 
 Families
 --------
@@ -75,7 +76,9 @@ byte after the 32-byte header, stored at bytes 24..32. Stream: "MTSCT\\0\\0\\x01
 | vertices, triangles, roots, base triangles (u32 LE each) | FNV-1a/32
 (0x811c9dc5, 0x01000193) of the body after the 28-byte header at bytes
 24..28. Resealing rewrites the length (.mts) and the checksum. Note that
-`mts decode --bytes N` does not check the checksum at all (prefix mode).
+`mts decode --bytes N` with N below the file length decodes a prefix and
+does not check the checksum (it covers the whole body); N at or past the
+end decodes the whole file strictly, checksum included.
 
 Classification of a run
 -----------------------
@@ -96,7 +99,8 @@ For file errors (clean or unnamed) the harness also records whether the
 message names a place: "line N", "byte N", "offset N", "column N", or an
 element and index ("vertex 3", "face 12", "step 4", "strip index 7", ...).
 
-Runs have stdin on /dev/null, stdout discarded, RUST_BACKTRACE=0, their own
+Runs use a copy of the binary taken at the start (its sha1 is reported),
+have stdin on /dev/null, stdout discarded, RUST_BACKTRACE=0, their own
 process group and working directory. Exit status: 0 when no run is a panic,
 hang, oom or garbage accepted; 1 otherwise; 2 when the harness cannot run
 (binary missing, seeds cannot be made).
@@ -104,6 +108,7 @@ hang, oom or garbage accepted; 1 otherwise; 2 when the harness cannot run
 
 import argparse
 import collections
+import hashlib
 import json
 import math
 import os
@@ -453,6 +458,140 @@ def ply_bytes(pos, faces, enc="ascii", coord="float", count="uchar", index="int"
     return bytes(out)
 
 
+INT_RANGE = {"char": (-128, 127), "uchar": (0, 255), "short": (-32768, 32767), "ushort": (0, 65535),
+             "int": (-2 ** 31, 2 ** 31 - 1), "uint": (0, 2 ** 32 - 1)}
+TYPE_ALIASES = {"int8": "char", "uint8": "uchar", "int16": "short", "uint16": "ushort", "int32": "int",
+                "uint32": "uint", "float32": "float", "float64": "double"}
+ASCII_INT = re.compile(rb"^[+-]?[0-9]+$")
+ASCII_FLOAT = re.compile(rb"^[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?$")
+
+
+class Unsure(Exception):
+    pass
+
+
+def ply_verdict(data):
+    """A strict reference reading of a PLY file, to tell whether a mutated
+    file must be refused: "invalid" when any reader must fail (the data
+    ends inside a declared element, a negative list length, a coordinate
+    that is not a finite f32, a vertex index outside the declared
+    vertices), "valid" when it reads through, "unsure" when the header or a
+    token is beyond what this reference decides (unknown lines, odd number
+    syntax, values outside their type)."""
+    try:
+        return _ply_verdict(data)
+    except Unsure:
+        return "unsure"
+    except Exception:  # noqa: BLE001 - anything unexpected: no verdict
+        return "unsure"
+
+
+def _ply_verdict(data):
+    end = data.find(b"end_header")
+    if end < 0 or end > 64 * 1024:
+        raise Unsure
+    nl = data.find(b"\n", end)
+    if nl < 0:
+        raise Unsure
+    lines = data[:nl].split(b"\n")
+    if lines[0].strip() != b"ply":
+        raise Unsure
+    enc, elements = None, []
+    for line in lines[1:]:
+        w = line.split()
+        if not w or w[0] in (b"comment", b"obj_info"):
+            continue
+        if w[0] == b"format" and len(w) == 3:
+            enc = w[1].decode()
+        elif w[0] == b"element" and len(w) == 3 and ASCII_INT.match(w[2]) and int(w[2]) >= 0:
+            elements.append((w[1].decode(), int(w[2]), []))
+        elif w[0] == b"property" and len(w) == 5 and w[1] == b"list" and elements:
+            c, i = (TYPE_ALIASES.get(x.decode(), x.decode()) for x in (w[2], w[3]))
+            if c not in INT_RANGE or i not in SCALAR:
+                raise Unsure
+            elements[-1][2].append((w[4].decode(), c, i))
+        elif w[0] == b"property" and len(w) == 3 and elements:
+            t = TYPE_ALIASES.get(w[1].decode(), w[1].decode())
+            if t not in SCALAR:
+                raise Unsure
+            elements[-1][2].append((w[2].decode(), t, None))
+        elif w == [b"end_header"]:
+            break
+        else:
+            raise Unsure
+    if enc not in ("ascii", "binary_little_endian", "binary_big_endian"):
+        raise Unsure
+    body = data[nl + 1 :]
+    nv = next((n for name, n, _ in elements if name == "vertex"), 0)
+    if enc == "ascii":
+        tokens = iter(body.split())
+
+        def read(t):
+            tok = next(tokens, None)
+            if tok is None:
+                raise EOFError
+            if t in INT_RANGE:
+                if not ASCII_INT.match(tok):
+                    raise Unsure
+                v = int(tok)
+                lo, hi = INT_RANGE[t]
+                if not lo <= v <= hi:
+                    raise Unsure
+                return v
+            if not ASCII_FLOAT.match(tok):
+                raise Unsure
+            return float(tok)
+    else:
+        e = "<" if enc == "binary_little_endian" else ">"
+        pos = [0]
+
+        def read(t):
+            f = e + SCALAR[t]
+            n = struct.calcsize(f)
+            if pos[0] + n > len(body):
+                raise EOFError
+            v = struct.unpack_from(f, body, pos[0])[0]
+            pos[0] += n
+            return v
+    try:
+        for name, count, props in elements:
+            if not props:
+                continue
+            names = [p[0] for p in props]
+            if name == "vertex" and not all(a in names for a in "xyz"):
+                raise Unsure
+            index_prop = None
+            if name in ("face", "tristrips"):
+                lists = [p for p in props if p[2] is not None and p[0] in ("vertex_indices", "vertex_index")]
+                if not lists or lists[0][2] not in INT_RANGE:
+                    raise Unsure
+                index_prop = lists[0][0]
+            for _ in range(count):
+                for pname, t, item in props:
+                    if item is None:
+                        v = read(t)
+                        if name == "vertex" and pname in "xyz" and len(pname) == 1:
+                            if v != v:
+                                return "invalid"
+                            try:
+                                struct.pack("<f", v)
+                            except OverflowError:
+                                return "invalid"
+                            if math.isinf(v):
+                                return "invalid"
+                        continue
+                    n = read(t)
+                    if n < 0:
+                        return "invalid"
+                    for _ in range(n):
+                        v = read(item)
+                        if pname == index_prop and not (0 <= v < nv or (name == "tristrips" and v == -1)):
+                            return "invalid"
+    except EOFError:
+        return "invalid"
+    return "valid"
+
+
 def grid_strips(n, m):
     strips = []
     for y in range(m):
@@ -682,20 +821,15 @@ def gen_ply(rng, seeds):
     data = full
     if kind == "truncate":
         data = truncate(rng, full)
-        if len(data) < len(full):
-            if binary:
-                expect = GARBAGE
-            else:
-                head = full.index(b"end_header")
-                if len(data) < head + len(b"end_header") or len(data.split()) < len(full.split()):
-                    expect = GARBAGE
+        head = full.index(b"end_header") + len(b"end_header\n")
+        if len(data) < head or (binary and len(data) < len(full)) or len(data.split()) < len(full.split()):
+            expect = GARBAGE
     elif kind == "flip":
         data, _ = flip(rng, full)
     elif kind in ("count_up", "face_count_up"):
         key = "vertex" if kind == "count_up" else "face"
         base = len(pos) if key == "vertex" else len(items)
         data = ply_bytes(pos, faces, element_counts={key: base + rng.choice([1, 2, 100])}, **kw)
-        expect = GARBAGE
     elif kind == "count_huge":
         key = rng.choice(["vertex", "face"])
         v = rng.choice([4294967295, 4294967296, 10 ** 18, 18446744073709551615, 18446744073709551616, -1, "1e9", "0x10"])
@@ -722,7 +856,6 @@ def gen_ply(rng, seeds):
         if kw.get("count") == "int":
             big = rng.choice([255, 2 ** 31 - 1, -5])
         data = ply_bytes(pos, faces, last_count=big, **kw)
-        expect = GARBAGE
     elif kind == "index_range":
         items2 = [list(f) for f in items]
         k = rng.randrange(len(items2))
@@ -760,6 +893,11 @@ def gen_ply(rng, seeds):
         expect = GARBAGE if junk.startswith(("elephant", "property list uchar", "comment y", "ply")) else UNKNOWN
     else:
         expect = VALID
+    if kind in ("flip", "count_up", "face_count_up", "count_down", "last_count"):
+        # Whether these must be refused depends on where the bytes fall: the
+        # reference reading decides (a raised vertex count can realign onto
+        # the faces as one empty face, a valid file).
+        expect = GARBAGE if ply_verdict(data) == "invalid" else UNKNOWN
     case = Case("ply", "%s/%s" % (kind, name), ".ply", data)
     mesh_runs(case, rng, expect)
     return case
@@ -880,10 +1018,15 @@ def gen_mts(rng, seeds, render_ok):
         expect = VALID
     if data is None:
         data = m.to_bytes()
-    case = Case("mts", "%s/%s" % (kind, name), ".mts", data)
+    case = Case("mts", "%s/%s" % (kind, name[:-4]), ".mts", data)
     case.run(["info", "{in}", "--json"] if rng.random() < 0.3 else ["info", "{in}"], expect)
     case.run(["verify", "{in}", "--lods", "4"], expect)
-    case.run(rng.choice(MTS_CMDS), expect)
+    extra = list(rng.choice(MTS_CMDS))
+    if MtsFile(full).optimal and extra[-1] in ("pm", "multilevel"):
+        # The progressive and multilevel baselines refuse optimal placement
+        # (an argument error, not the file's).
+        extra[-1] = "mts"
+    case.run(extra, expect)
     if render_ok:
         case.run(["render", "{in}", "--size", "32x32", "--ratio", "0.5", "-o", "{out}.png"], expect)
     return case
@@ -930,16 +1073,19 @@ def gen_stream(rng, seeds):
         strict = VALID
     if data is None:
         data = seal_stream(bytes(b))
-    case = Case("stream", "%s/%s" % (kind, name), ".stream", data)
+    case = Case("stream", "%s/%s" % (kind, name[:-7]), ".stream", data)
     case.run(["decode", "{in}"], strict)
     cut = rng.randrange(0, len(data) + 16)
     # A prefix decode does not check the checksum: only header and packet
-    # corruption can be caught there.
+    # corruption can be caught there. --bytes at or past the end decodes the
+    # whole file, strictly.
     prefix_expect = UNKNOWN
     if kind in ("roots_over", "base_over", "roots_zero", "magic") and cut >= STREAM_HEADER:
         prefix_expect = GARBAGE
     if cut < STREAM_HEADER:
         prefix_expect = GARBAGE  # not even a header
+    if cut >= len(data):
+        prefix_expect = strict
     case.run(["decode", "{in}", "--bytes", str(cut)], prefix_expect)
     if rng.random() < 0.5:
         case.run(["decode", "{in}", "-o", "{out}.obj", "--json"], strict)
@@ -1004,6 +1150,12 @@ def args_table():
         add(["render"] + G + ["--size", "32x32", "--scene", v, "-o", "{out}.png"], e)
         add(["bench", "render"] + G + ["--size", "32x32", "--frames", "1", "--scene", v, "--json"], e)
         add(["bench", "render"] + G + ["--size", "32x32", "--scene", "0", "--frames", v, "--json"], e)
+    # A negative value as its own word is taken by clap for an unknown flag:
+    # pass it as --flag=VALUE so that the value's own check is reached.
+    for argv, _ in t:
+        for i in range(len(argv) - 2, -1, -1):
+            if argv[i].startswith("--") and argv[i + 1].startswith("-") and not argv[i + 1].startswith("--"):
+                argv[i : i + 2] = ["%s=%s" % (argv[i], argv[i + 1])]
     add(["info", "{seed:mts}", "--json", "--json"], GARBAGE)
     add(["info"], GARBAGE)
     add(["decode"], GARBAGE)
@@ -1339,7 +1491,9 @@ def signature(cls, cmd, stderr, family, kind):
     and the panic location or first stderr line with numbers and paths
     blanked; for accepted garbage and hangs (no message), the input's
     family and kind."""
-    if cls in ("garbage accepted", "hang"):
+    if cls == "garbage accepted":
+        return (cls, "", "%s/%s" % (family, kind.split("/")[0]))
+    if cls == "hang":
         return (cls, cmd, "%s/%s" % (family, kind.split("/")[0]))
     lines = [l for l in stderr.splitlines() if l.strip()]
     key = ""
@@ -1508,13 +1662,23 @@ def main():
     root = tempfile.mkdtemp(prefix="mts-hostile-")
     t0 = time.monotonic()
     try:
+        # Run a copy: a rebuild of the binary during the run must not mix
+        # two binaries in one report (or find none for a moment).
+        snap = os.path.join(root, "mts")
         try:
-            seeds = make_seeds(mts_bin, root, timeout)
+            shutil.copy2(mts_bin, snap)
+            with open(snap, "rb") as f:
+                digest = hashlib.sha1(f.read()).hexdigest()
+        except OSError as e:
+            print("hostile.py: cannot copy %s: %s" % (mts_bin, e), file=sys.stderr)
+            return 2
+        try:
+            seeds = make_seeds(snap, root, timeout)
         except (RuntimeError, subprocess.TimeoutExpired, struct.error, IndexError) as e:
             print("hostile.py: cannot make the seeds: %s" % e, file=sys.stderr)
             return 2
         ctx = Ctx()
-        ctx.mts, ctx.seed, ctx.seeds, ctx.root = mts_bin, seed, seeds, root
+        ctx.mts, ctx.seed, ctx.seeds, ctx.root = snap, seed, seeds, root
         ctx.timeout, ctx.mem_bytes, ctx.keep, ctx.quick = timeout, int(a.mem_gb * (1 << 30)), a.keep, a.quick
         ctx.seed_shown = "seeds"
         if a.keep:
@@ -1549,7 +1713,8 @@ def main():
 
     table = summarize(results, families)
     out = sys.stdout
-    print("mts hostile inputs: seed %d, %d inputs, %d runs, timeout %g s, memory cap %g GB, %d jobs, %.0f s"
+    print("mts hostile inputs: %s (sha1 %s)" % (a.mts, digest[:12]), file=out)
+    print("seed %d, %d inputs, %d runs, timeout %g s, memory cap %g GB, %d jobs, %.0f s"
           % (seed, table["total"]["inputs"], table["total"]["runs"], timeout, a.mem_gb, a.jobs, elapsed), file=out)
     print_table(table, out)
     bad = [r for r in results if r["cls"] not in ("clean error", "ok")]
@@ -1579,8 +1744,13 @@ def main():
             print("  [%s] x%d  %s  (%s, %d bytes)" % (c["cls"], c["runs"], c["command"], c["kind"], c["input_bytes"]), file=out)
             if c["stderr"]:
                 print("    | %s" % c["stderr"][0], file=out)
+    no_place = collections.defaultdict(collections.Counter)
+    for r in results:
+        if r["file_error"] and not r["place"] and r["stderr"]:
+            msg = re.sub(r"\d+", "N", re.sub(r"/\S*|input(\.\w+)?\b", "<file>", r["stderr"][0]))
+            no_place[r["family"]][msg[:200]] += 1
     if a.json:
-        summary = dict(binary=mts_bin, seed=seed, count=count, quick=a.quick, timeout_s=timeout, mem_gb=a.mem_gb,
+        summary = dict(errors_naming_no_place={f: c.most_common(20) for f, c in no_place.items()},binary=mts_bin, binary_sha1=digest, seed=seed, count=count, quick=a.quick, timeout_s=timeout, mem_gb=a.mem_gb,
                        jobs=a.jobs, families=families, elapsed_s=round(elapsed, 1), table=table,
                        failed=bool(failing), non_clean=bad, causes=list(causes.values()))
         with open(a.json, "w") as f:

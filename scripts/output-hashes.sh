@@ -16,7 +16,7 @@ trap 'rm -rf "$work"' EXIT
 strip_times() {
   python3 -c '
 import json, re, sys
-t = re.compile(r"(^|_)(ms|us|s|ns)$|time|elapsed|per_second|fps")
+t = re.compile(r"(^|_)(ms|us|s|ns)($|_)|time|elapsed|per_second|fps|seconds")
 def f(v):
     if isinstance(v, dict):
         return {k: f(x) for k, x in v.items() if not t.search(k)}

@@ -33,17 +33,28 @@ fn gpu() -> Option<Gpu> {
             let report = gpu.report();
             eprintln!("adapter: {report}");
             if report.strip_mode != StripMode::Restart {
+                assert!(
+                    !required_gpu(),
+                    "MTS_REQUIRE names gpu and the default adapter ignores primitive restart"
+                );
                 eprintln!("skipped: the default adapter ignores primitive restart");
                 return None;
             }
             Some(gpu)
         }
         Err(Error::NoAdapter(why)) => {
+            assert!(!required_gpu(), "MTS_REQUIRE names gpu: no adapter ({why})");
             eprintln!("skipped: no graphics adapter ({why}); install mesa-vulkan-drivers");
             None
         }
         Err(e) => panic!("GPU setup failed: {e}"),
     }
+}
+
+/// Whether `MTS_REQUIRE` (set by `.ci/run`) names `gpu`: a missing
+/// adapter then fails instead of skipping.
+fn required_gpu() -> bool {
+    std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w.trim() == "gpu"))
 }
 
 fn model_of(mesh: &Mesh) -> MtsModel {
@@ -389,6 +400,10 @@ fn gl_backend_stitches_and_covers_what_the_oracle_covers() {
     let gpu = match Gpu::new_headless_on(wgpu::Backends::GL) {
         Ok(gpu) => gpu,
         Err(Error::NoAdapter(why)) => {
+            assert!(
+                !required_gpu(),
+                "MTS_REQUIRE names gpu: no GL adapter ({why})"
+            );
             eprintln!("skipped: no GL adapter ({why})");
             return;
         }
@@ -524,4 +539,86 @@ fn scene_culls_and_updates_like_a_fresh_scene() {
     eprintln!("scene across: {fg} pixels differ from the top-left corner");
     assert!(fg >= 10_000, "{fg}");
     assert_eq!(difference(&image, &expected), (0, 0));
+}
+
+/// The GPU on `backends`, or `None` with a message (a failure when
+/// `MTS_REQUIRE` names gpu).
+fn gpu_on(backends: wgpu::Backends, what: &str) -> Option<Gpu> {
+    match Gpu::new_headless_on(backends) {
+        Ok(gpu) => Some(gpu),
+        Err(Error::NoAdapter(why)) => {
+            assert!(
+                !required_gpu(),
+                "MTS_REQUIRE names gpu: no {what} adapter ({why})"
+            );
+            eprintln!("skipped: no {what} adapter ({why})");
+            None
+        }
+        Err(e) => panic!("{what} setup failed: {e}"),
+    }
+}
+
+/// Issue 19: the instanced scene refused backends without primitive
+/// restart. On GL it now stitches each instance's runs and covers the same
+/// pixels as the restart path on Vulkan.
+#[test]
+fn instanced_scene_on_gl_covers_what_vulkan_covers() {
+    let (Some(gl), Some(vk)) = (
+        gpu_on(wgpu::Backends::GL, "GL"),
+        gpu_on(wgpu::Backends::VULKAN, "Vulkan"),
+    ) else {
+        return;
+    };
+    assert_eq!(gl.report().strip_mode, StripMode::Stitched);
+    assert_eq!(vk.report().strip_mode, StripMode::Restart);
+    let mesh: Mesh = "torus:2k".parse::<Generated>().unwrap().build();
+    let model = model_of(&mesh);
+    let mut images = Vec::new();
+    for gpu in [&gl, &vk] {
+        let config = RendererConfig::headless(gpu.report().strip_mode);
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let target = HeadlessTarget::new(d, WIDTH, HEIGHT).unwrap();
+        let mut scene = InstancedScene::new(d, q, &config, &model, 50).unwrap();
+        let camera = scene.overview_camera(target.aspect());
+        let stats = scene.update(q, &camera, HEIGHT as f32);
+        assert!(
+            stats.visible > 10 && stats.lod_changes == stats.visible,
+            "{stats:?}"
+        );
+        images.push((
+            stats,
+            target.render_image(d, q, |pass| scene.draw(pass)).unwrap(),
+        ));
+    }
+    let ((gl_stats, gl_image), (vk_stats, vk_image)) = (&images[0], &images[1]);
+    assert_eq!(gl_stats.visible, vk_stats.visible);
+    assert_eq!(gl_stats.triangles, vk_stats.triangles);
+    let covered = vk_image.foreground_pixels();
+    assert!(covered > 5_000, "{covered}");
+    // Two rasterisers (llvmpipe through GL and through Vulkan) may differ
+    // on a few edge pixels, never on coverage.
+    let differing = gl_image.differing_pixels(vk_image);
+    assert!(
+        differing * 200 <= covered,
+        "{differing} of {covered} pixels differ"
+    );
+}
+
+/// Issue 19: an image whose readback buffer passes the device's
+/// `max_buffer_size` is an error, not a wgpu validation panic.
+#[test]
+fn readback_beyond_the_device_limit_is_an_error() {
+    let Some(gpu) = gpu() else { return };
+    let max = gpu.device.limits().max_buffer_size;
+    let side = gpu.device.limits().max_texture_dimension_2d;
+    // Rows of `side` pixels (4 bytes each), enough of them to pass `max`.
+    let rows = (max / (4 * u64::from(side)) + 1).min(u64::from(side)) as u32;
+    if 4 * u64::from(side) * u64::from(rows) <= max {
+        eprintln!("skipped: this device's buffers hold any image ({max} bytes)");
+        return;
+    }
+    match HeadlessTarget::new(&gpu.device, side, rows) {
+        Err(Error::InvalidArgument(m)) => assert!(m.contains("max_buffer_size"), "{m}"),
+        other => panic!("expected an InvalidArgument, got {:?}", other.map(|_| ())),
+    }
 }

@@ -91,8 +91,31 @@ use glam::{DVec3, Vec3};
 /// # Panics
 /// If `mesh` breaks the [`Mesh`] invariants (check with
 /// [`Mesh::validate`] first; loaders and generators guarantee them).
+///
+/// Coordinates far from 1 (beyond 2^±40, e.g. 1e20 or 1e-25) are simplified
+/// in a frame scaled by a power of two ([`crate::mesh::power_of_two_scale`]):
+/// the queue's `f32` costs are squared distances and would overflow or
+/// vanish in model units. The scaling is exact, errors are relative to the
+/// diagonal, and created vertices are scaled back exactly, so the result is
+/// the sequence of the true coordinates; ordinary models are not scaled.
 #[must_use]
 pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
+    let scale = crate::mesh::power_of_two_scale(&mesh.positions);
+    if scale != 1.0 {
+        let scaled = Mesh {
+            positions: mesh
+                .positions
+                .iter()
+                .map(|p| (p.as_dvec3() * scale).as_vec3())
+                .collect(),
+            triangles: mesh.triangles.clone(),
+        };
+        let mut result = simplify(&scaled, options);
+        for p in &mut result.collapses.appended {
+            *p = (p.as_dvec3() / scale).as_vec3();
+        }
+        return result;
+    }
     let mut c = Contractor::new(mesh, options);
     c.run(options.stop_at_triangles);
     c.finish()

@@ -148,6 +148,35 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<RawMesh> {
     for element in &header.elements {
         read_element(&mut reader, element, vertex_count, &mut raw, &file)?;
     }
+    // What follows the last element is not part of the mesh: a wrong count
+    // in the header, or two files run together. Whitespace ends ASCII data.
+    let trailing = |at: usize, line: Option<u64>| Error::Parse {
+        file: file.clone(),
+        place: Place {
+            line,
+            ..Place::default()
+        }
+        .at_byte(at as u64),
+        message: format!(
+            "{} bytes after the data of the header's elements (do the header's counts match \
+             the data?)",
+            bytes.len() - at
+        ),
+    };
+    match &reader {
+        Reader::Ascii(r) => {
+            let rest = &bytes[r.pos.min(bytes.len())..];
+            if let Some(k) = rest.iter().position(|b| !b.is_ascii_whitespace()) {
+                let line = r.line + rest[..k].iter().filter(|&&b| b == b'\n').count() as u64;
+                return Err(trailing(r.pos + k, Some(line)));
+            }
+        }
+        Reader::Binary(r) => {
+            if r.pos < bytes.len() {
+                return Err(trailing(r.pos, None));
+            }
+        }
+    }
     Ok(raw)
 }
 
