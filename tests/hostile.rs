@@ -108,7 +108,7 @@ fn coincident_triangles_pair_rank_by_rank() {
             .iter()
             .filter(|&&n| n != NO_NEIGHBOUR)
             .count();
-        let expected = if t < 150 || t >= 200 { 3 } else { 0 };
+        let expected = if (150..200).contains(&t) { 0 } else { 3 };
         assert_eq!(paired, expected, "triangle {t}");
     }
     for slot in 0..3 {

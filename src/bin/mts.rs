@@ -386,7 +386,7 @@ struct StripsArgs {
     #[arg(long)]
     min_patch: Option<usize>,
     /// Only this swap penalty in the local pass (see StripifyOptions).
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long, value_parser = non_negative::<f32>)]
     swap_penalty: Option<f32>,
     /// Do not join strips whose ends are neighbours.
     #[arg(long)]

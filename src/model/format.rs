@@ -280,7 +280,15 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
     if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
         return Err(Error::UnknownFormat {
             file: file.to_owned(),
-            message: "not an .mts file (magic \"MTSMODEL\" missing)".into(),
+            message: if bytes.len() < HEADER_LEN {
+                format!(
+                    "not an .mts file: {} bytes, shorter than the {HEADER_LEN}-byte header \
+                     (byte 0 on)",
+                    bytes.len()
+                )
+            } else {
+                "not an .mts file: byte 0: magic \"MTSMODEL\" missing".into()
+            },
         });
     }
     let u32_at =
@@ -294,7 +302,7 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
     if version != VERSION {
         return Err(Error::UnknownFormat {
             file: file.to_owned(),
-            message: format!(".mts version {version}; this build reads version {VERSION}"),
+            message: format!("byte 8: .mts version {version}; this build reads version {VERSION}"),
         });
     }
     let header = |byte, m: String| parse_error(file, byte, "header", m);

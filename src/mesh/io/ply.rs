@@ -191,7 +191,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
         message,
     };
     if !(bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n")) {
-        return Err(unknown("not a PLY file: the first line is not `ply`"));
+        return Err(unknown("not a PLY file: line 1 is not `ply`"));
     }
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
