@@ -11,11 +11,12 @@ set -uo pipefail
 mts=${1:-target/release/mts}
 models=${MODELS:-$(dirname "$0")/../../shared/models}
 work=$(mktemp -d)
+export WORK=$work
 trap 'rm -rf "$work"' EXIT
 # Timings differ from run to run: drop keys that hold them.
 strip_times() {
   python3 -c '
-import json, re, sys
+import json, os, re, sys
 t = re.compile(r"(^|_)(ms|us|s|ns)($|_)|time|elapsed|per_second|fps|seconds")
 def f(v):
     if isinstance(v, dict):
@@ -23,8 +24,9 @@ def f(v):
     if isinstance(v, list):
         return [f(x) for x in v]
     return v
+text = sys.stdin.read().replace(os.environ["WORK"], "WORK")
 try:
-    print(json.dumps(f(json.load(sys.stdin)), sort_keys=True))
+    print(json.dumps(f(json.loads(text)), sort_keys=True))
 except Exception as e:
     print("not json:", e)
 '

@@ -22,7 +22,7 @@ use std::path::Path;
 /// side: a 100,000-corner face made a vertex of valence 100,000, which
 /// every per-vertex loop downstream (adjacency, the vertex-cache
 /// optimiser, distance queries over sliver triangles) paid for squared;
-/// the zigzag keeps every valence at most 4 and the triangles' boxes apart.
+/// the zigzag keeps every valence at most 3 and the triangles' boxes apart.
 /// No shared model has a face of more than four corners, so no output
 /// changed.
 pub(crate) fn triangulate_polygon(ids: &[u32], out: &mut Vec<[u32; 3]>) {
