@@ -395,3 +395,33 @@ fn decode_of_the_whole_stream_checks_the_checksum() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The OBJ and PLY fuzz targets' kept inputs (`fuzz/regressions/parse_obj`,
+/// `parse_ply`): each parses to an error or to a mesh that cleans into a
+/// valid one, without a panic.
+#[test]
+fn loader_fuzz_regressions_stay_fixed() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions");
+    let mut seen = 0;
+    for (folder, parse) in [
+        (
+            "parse_obj",
+            parse_obj as fn(&[u8], &Path) -> mts::Result<RawMesh>,
+        ),
+        ("parse_ply", parse_ply),
+    ] {
+        let Ok(entries) = std::fs::read_dir(root.join(folder)) else {
+            continue;
+        };
+        for e in entries.flatten().filter(|e| e.path().is_file()) {
+            let bytes = std::fs::read(e.path()).unwrap();
+            if let Ok(raw) = parse(&bytes, &e.path()) {
+                if let Ok((m, _)) = clean(raw, Default::default(), "fuzz") {
+                    m.validate().unwrap();
+                }
+            }
+            seen += 1;
+        }
+    }
+    eprintln!("{seen} loader fuzz inputs");
+}
