@@ -173,17 +173,39 @@ property float y\nproperty float z\nend_header\n"
 #[test]
 fn obj_lines_are_not_triangles_and_short_faces_are_counted() {
     let raw = parse_obj(
-        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\nf 1 2\nf 1\n",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\nf 1 2\nf 1\nf 1 2 3\n",
         Path::new("t.obj"),
     )
     .unwrap();
-    assert!(raw.triangles.is_empty());
+    assert_eq!(raw.triangles, vec![[0, 1, 2]]);
     assert_eq!(raw.degenerate_in_source, 2);
+    // Without the last face nothing is left: an error at the first face.
+    let place = parse_error_place(parse_obj(
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\nf 1 2\nf 1\n",
+        Path::new("t.obj"),
+    ));
+    assert_eq!((place.line, place.byte), (Some(5), Some(32)));
+    // No face at all: an error at the last line.
+    let place = parse_error_place(parse_obj(b"v 0 0 0\nv 1 0 0\n", Path::new("t.obj")));
+    assert_eq!((place.line, place.byte), (Some(2), Some(8)));
     let place = parse_error_place(parse_obj(
         b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/4 2/4 3/4\n",
         Path::new("t.obj"),
     ));
     assert_eq!(place.line, Some(4));
+}
+
+#[test]
+fn a_ply_of_no_triangle_names_where_its_data_starts() {
+    let header = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    let mut text = header.to_vec();
+    text.extend_from_slice(b"0 0 0\n1 0 0\n0 1 0\n3 0 1 1\n");
+    let place = parse_error_place(parse_ply(&text, Path::new("t.ply")));
+    assert_eq!(
+        (place.line, place.byte),
+        (Some(10), Some(header.len() as u64))
+    );
 }
 
 #[test]

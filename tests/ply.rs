@@ -232,7 +232,18 @@ fn unknown_formats_are_named() {
 fn missing_coordinates_and_empty_meshes_are_refused() {
     let e = error_of(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n");
     assert!(e.contains("line 3") && e.contains("`z`"), "{e}");
-    let raw = parse(b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n").unwrap();
+    // Vertices without faces: refused by the reader, at the data's start.
+    let e = error_of(b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
+    assert!(
+        e.contains("line 8") && e.contains("no face of three distinct vertices"),
+        "{e}"
+    );
+    // A raw mesh from elsewhere without triangles: refused by clean.
+    let raw = mts::mesh::RawMesh {
+        positions: vec![glam::Vec3::ZERO; 3],
+        triangles: Vec::new(),
+        degenerate_in_source: 0,
+    };
     let e = clean(raw, CleanOptions::default(), "test.ply").unwrap_err();
     assert!(e.to_string().contains("test.ply: empty mesh"), "{e}");
 }

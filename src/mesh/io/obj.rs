@@ -61,6 +61,8 @@ struct Reader<'p> {
     stamp: Vec<u32>,
     local: Vec<u32>,
     object: u32,
+    /// Line and byte of the first face statement.
+    first_face: Option<(u64, u64)>,
 }
 
 /// Parses OBJ text into a raw mesh (geometry only).
@@ -98,13 +100,16 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
         stamp: Vec::new(),
         local: Vec::new(),
         object: 0,
+        first_face: None,
     };
     let start = if bytes.starts_with(&[0xEF, 0xBB, 0xBF]) {
         3
     } else {
         0
     };
+    let mut end = (1u64, start as u64);
     for (number, offset, line) in lines(bytes, start) {
+        end = (number, offset);
         if let Some(nul) = line.iter().position(|&b| b == 0) {
             return Err(err(
                 number,
@@ -126,6 +131,34 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
     }
     reader.end_object()?;
     reader.check_attribute_ranges()?;
+    // A file without one triangle of three distinct vertices is no mesh:
+    // said here, where the place is known (the first face, or the end).
+    if reader
+        .raw
+        .triangles
+        .iter()
+        .all(|&t| crate::mesh::is_degenerate(t))
+    {
+        let (line, byte, message) = match reader.first_face {
+            Some((line, byte)) => (
+                line,
+                byte,
+                format!(
+                    "no face has three distinct vertices ({} triangles, all repeating a \
+                     vertex; the first face is here)",
+                    reader.raw.triangles.len()
+                ),
+            ),
+            None => (
+                end.0,
+                end.1,
+                "end of file and no face of three or more corners (`f` statements): no \
+                 triangle to read"
+                    .into(),
+            ),
+        };
+        return Err(reader.error(line, byte, "f", message));
+    }
     Ok(reader.raw)
 }
 
@@ -292,6 +325,7 @@ impl Reader<'_> {
         line: u64,
         byte: u64,
     ) -> Result<()> {
+        self.first_face.get_or_insert((line, byte));
         let first = self.corners.len();
         for (k, corner) in words.enumerate() {
             let mut parts = corner.split('/');

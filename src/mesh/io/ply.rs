@@ -177,6 +177,25 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<RawMesh> {
             }
         }
     }
+    // No triangle of three distinct vertices: no mesh, said where the data
+    // starts (clean would say it of the whole file).
+    if raw.triangles.iter().all(|&t| crate::mesh::is_degenerate(t)) {
+        let place = match header.encoding {
+            Encoding::Ascii => Place::line(header.data_line),
+            _ => Place::default(),
+        }
+        .at_byte(header.data_start as u64);
+        return Err(Error::Parse {
+            file,
+            place,
+            message: format!(
+                "the data from here holds no face of three distinct vertices ({} faces or \
+                 strip triangles, {} dropped as degenerate)",
+                raw.triangles.len(),
+                raw.degenerate_in_source
+            ),
+        });
+    }
     Ok(raw)
 }
 
