@@ -447,3 +447,31 @@ fn loader_fuzz_regressions_stay_fixed() {
     }
     eprintln!("{seen} loader fuzz inputs");
 }
+
+/// A headless render printed libwayland's "error: XDG_RUNTIME_DIR is
+/// invalid or not set" twice (Mesa's device-select layer probing for a
+/// display); it is switched off when there is no session.
+#[test]
+fn a_headless_render_prints_no_window_system_error() {
+    let dir = std::env::temp_dir().join(format!("mts-xdg-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("t.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_mts"))
+        .args([
+            "render",
+            "--generated",
+            "torus:200",
+            "--size",
+            "32x32",
+            "-o",
+        ])
+        .arg(&png)
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

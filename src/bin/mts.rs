@@ -1229,6 +1229,18 @@ fn info(args: &InfoArgs) -> Result<()> {
 }
 
 fn main() -> std::process::ExitCode {
+    // Mesa's implicit Vulkan layer VK_LAYER_MESA_device_select connects to
+    // Wayland to rank GPUs by the display they drive, and without
+    // XDG_RUNTIME_DIR (no Wayland session: a headless run) libwayland prints
+    // "error: XDG_RUNTIME_DIR is invalid or not set" twice, as if it were
+    // ours. With no session there is no display to rank by: the layer is
+    // switched off by its documented variable, unless the user set it.
+    // Set before any thread starts.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none()
+        && std::env::var_os("NODEVICE_SELECT").is_none()
+    {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
     let cli = Cli::parse();
     match run(&cli) {
         Ok(()) => std::process::ExitCode::SUCCESS,
