@@ -91,9 +91,10 @@ impl Format {
         }
         Err(Error::UnknownFormat {
             file: path.to_owned(),
-            message: "expected a .obj or .ply file (no extension matched and the content \
+            message:
+                "expected a .obj or .ply file (no extension matched, and from byte 0 the content \
                       starts with neither a `ply` line nor OBJ statements)"
-                .into(),
+                    .into(),
         })
     }
 }
