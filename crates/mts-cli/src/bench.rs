@@ -1,0 +1,1037 @@
+//! `mts bench`: the MTS paper's tables measured on this machine, written as
+//! `report.md` and `results.json` (schema in `docs/bench-schema.md`).
+//!
+//! Every figure of a row is measured in the same run as the figures it is
+//! compared with. Timings are medians of a few repetitions; the machine
+//! section names the CPU they come from.
+
+use anyhow::{Context, Result};
+use mts::distance::{surface_distance, Surface};
+use mts::model::{build_from_mesh, sequence, PipelineOptions};
+use mts::peers;
+use mts::strip::acmr::{fifo_acmr, CACHE_SIZE};
+use mts::strip::encode::RESTART_U32;
+use mts::strip::stats::StripStats;
+use mts::{Extractor, Mesh, MtsModel, SimplifyOptions, StripifyOptions};
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Version of `results.json`'s layout (`docs/bench-schema.md`).
+pub const SCHEMA_VERSION: u32 = 2;
+
+/// Shares of the full triangle count reported in Tables 3–4.
+const SHARES: [f64; 6] = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
+/// Shares at which simplification quality is measured.
+const QUALITY_SHARES: [f64; 2] = [0.1, 0.01];
+/// Requests per Table 2 sequence (the full run; `--quick` uses fewer).
+const REQUESTS: usize = 1000;
+const QUICK_REQUESTS: usize = 200;
+/// Generated sizes of the scale section (triangles).
+const SCALE_SIZES: [&str; 6] = ["10k", "40k", "160k", "640k", "1M", "4M"];
+/// Surface samples per side for the quality section.
+const SAMPLES: usize = 100_000;
+/// Timed runs of the stripifiers and simplifiers per model (medians);
+/// `--quick` uses fewer.
+const STAGE_REPEAT: usize = 7;
+const QUICK_STAGE_REPEAT: usize = 3;
+/// Instances of the scene row (Figure 6's adapter), and with `--quick`.
+const SCENE_INSTANCES: usize = 1000;
+const QUICK_SCENE_INSTANCES: usize = 250;
+
+/// What to measure.
+pub struct BenchOptions {
+    /// Meshes to measure (files); empty with `quick` means the built-in one.
+    pub models: Vec<PathBuf>,
+    /// The built-in mesh only, fewer requests, no scale section.
+    pub quick: bool,
+    /// The command line, for the report.
+    pub command: String,
+    /// Measure Figure 6 (frames per second) with the headless renderer.
+    pub render: bool,
+}
+
+/// Shares of Figure 6, and its timed frames per point.
+const FIGURE6_SHARES: [f64; 6] = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
+const QUICK_FIGURE6_SHARES: [f64; 3] = [1.0, 0.25, 0.05];
+const FIGURE6_FRAMES: usize = 10;
+const QUICK_FIGURE6_FRAMES: usize = 4;
+
+/// The headless renderer of Figure 6, when the build and the machine have
+/// one; otherwise why not.
+type Figure6 = std::result::Result<super::figure6::Renderer, String>;
+
+fn figure6_renderer(wanted: bool) -> Figure6 {
+    if !wanted {
+        return Err("not asked for (--no-render)".into());
+    }
+    super::figure6::Renderer::new().map_err(|e| format!("no adapter: {e:#}"))
+}
+
+/// Runs every section and returns `results.json`'s value; `progress` is
+/// told what is being measured.
+pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
+    let mut models = Vec::new();
+    let mut inputs: Vec<(String, Mesh)> = Vec::new();
+    if options.models.is_empty() {
+        let g = mts::mesh::generate::Generated::DEFAULT;
+        inputs.push((format!("generated {g}"), g.build()));
+    }
+    for path in &options.models {
+        let (mesh, _) = mts::mesh::io::load(path, Default::default())
+            .with_context(|| format!("cannot load {}", path.display()))?;
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        );
+        inputs.push((name, mesh));
+    }
+    let requests = if options.quick {
+        QUICK_REQUESTS
+    } else {
+        REQUESTS
+    };
+    let renderer = figure6_renderer(options.render);
+    let (shares, frames): (&[f64], usize) = if options.quick {
+        (&QUICK_FIGURE6_SHARES, QUICK_FIGURE6_FRAMES)
+    } else {
+        (&FIGURE6_SHARES, FIGURE6_FRAMES)
+    };
+    let repeat = if options.quick {
+        QUICK_STAGE_REPEAT
+    } else {
+        STAGE_REPEAT
+    };
+    // The scene row's model: the bunny when measured, else the first one.
+    let scene_name = inputs
+        .iter()
+        .map(|(n, _)| n)
+        .find(|n| *n == "bunny.ply")
+        .or(inputs.first().map(|(n, _)| n))
+        .cloned();
+    let mut scene = Value::Null;
+    for (name, mesh) in &inputs {
+        progress(name);
+        let (row, model) = measure_model(name, mesh, requests, repeat, &renderer, shares, frames)?;
+        models.push(row);
+        if scene_name.as_ref() == Some(name) {
+            scene = measure_scene(name, &model, options.quick, frames, &renderer, progress)?;
+        }
+    }
+    let scale = if options.quick {
+        Value::Null
+    } else {
+        progress("scale");
+        measure_scale(progress)
+    };
+    Ok(json!({
+        "schema": SCHEMA_VERSION,
+        "command": options.command,
+        "quick": options.quick,
+        "machine": machine(&renderer),
+        "models": models,
+        "scene": scene,
+        "scale": scale,
+        "fast_simplification": if options.quick {
+            Value::Null
+        } else {
+            progress("fast-simplification");
+            fast_simplification(&options.models)
+        },
+    }))
+}
+
+/// The fast-simplification peer (`crates/mts-cli/peers/fast_simplification.py`)
+/// at 10% and 1% of every model, its error measured by this binary's `mts
+/// distance`: one row per model and share, or `{"skipped": why}` when
+/// Python or the package is missing (`pip install fast-simplification
+/// numpy`).
+fn fast_simplification(models: &[PathBuf]) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("peers/fast_simplification.py");
+    let Ok(exe) = std::env::current_exe() else {
+        return json!({"skipped": "cannot find this binary for `mts distance`"});
+    };
+    if models.is_empty() {
+        return json!({"skipped": "no model files"});
+    }
+    let out = std::process::Command::new("python3")
+        .arg(&script)
+        .args(["--ratios", "0.1,0.01", "--repeat", "1", "--mts"])
+        .arg(&exe)
+        .args(models)
+        .output();
+    match out {
+        Err(e) => json!({"skipped": format!("python3: {e}")}),
+        Ok(o) if !o.status.success() => json!({
+            "skipped": String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or("failed").to_string()
+        }),
+        Ok(o) => Value::Array(
+            String::from_utf8_lossy(&o.stdout)
+                .lines()
+                .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+                .map(|mut v| {
+                    // The file name, as the models' rows name them.
+                    if let Some(name) = v["mesh"]
+                        .as_str()
+                        .and_then(|m| Path::new(m).file_name())
+                        .map(|n| n.to_string_lossy().into_owned())
+                    {
+                        v["mesh"] = Value::from(name);
+                    }
+                    v
+                })
+                .collect(),
+        ),
+    }
+}
+
+/// CPU, cores and system of this machine, and the graphics adapter of
+/// Figure 6 (`null` when none ran, with the reason in `adapter_note`).
+fn machine(renderer: &Figure6) -> Value {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    let os = std::fs::read_to_string("/etc/os-release")
+        .ok()
+        .and_then(|s| {
+            s.lines().find(|l| l.starts_with("PRETTY_NAME=")).map(|l| {
+                l.trim_start_matches("PRETTY_NAME=")
+                    .trim_matches('"')
+                    .to_string()
+            })
+        })
+        .unwrap_or_else(|| std::env::consts::OS.into());
+    json!({
+        "cpu": cpu,
+        "cores": std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
+        "os": os,
+        "adapter": match renderer {
+            Ok(r) => Value::from(r.adapter()),
+            Err(_) => Value::Null,
+        },
+        "adapter_note": renderer.as_ref().err().cloned(),
+    })
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Median over `repeat` runs of `f`, in microseconds.
+fn time_us(repeat: usize, mut f: impl FnMut()) -> f64 {
+    median(
+        (0..repeat.max(1))
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64() * 1e6
+            })
+            .collect(),
+    )
+}
+
+/// The scene row: [`SCENE_INSTANCES`] instances (fewer with `--quick`) of
+/// `model` on Figure 6's adapter; `null` without one.
+fn measure_scene(
+    name: &str,
+    model: &MtsModel,
+    quick: bool,
+    frames: usize,
+    renderer: &Figure6,
+    progress: &dyn Fn(&str),
+) -> Result<Value> {
+    let instances = if quick {
+        QUICK_SCENE_INSTANCES
+    } else {
+        SCENE_INSTANCES
+    };
+    match renderer {
+        Ok(r) => {
+            progress(&format!("scene of {instances} × {name}"));
+            let mut row = r.measure_scene(model, instances, frames)?;
+            row["model"] = Value::from(name);
+            Ok(row)
+        }
+        Err(_) => {
+            let _ = (name, model, instances, frames, progress);
+            Ok(Value::Null)
+        }
+    }
+}
+
+/// Medians of `repeat` interleaved runs of `a` and `b` (so that a drift of
+/// the machine's speed hits both alike), in milliseconds, with the last
+/// results.
+fn interleaved_ms<A, B>(
+    repeat: usize,
+    mut a: impl FnMut() -> A,
+    mut b: impl FnMut() -> B,
+) -> ((A, f64), (B, f64)) {
+    let (mut ta, mut tb) = (Vec::new(), Vec::new());
+    let (mut ra, mut rb) = (None, None);
+    for _ in 0..repeat.max(1) {
+        let t = Instant::now();
+        ra = Some(a());
+        ta.push(t.elapsed().as_secs_f64() * 1e3);
+        let t = Instant::now();
+        rb = Some(b());
+        tb.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    (
+        (ra.expect("one run"), median(ta)),
+        (rb.expect("one run"), median(tb)),
+    )
+}
+
+/// The project's stripifier against meshoptimizer's on `mesh` (the `mts
+/// strips` row): both strip sets' figures and median milliseconds.
+fn measure_stripify(mesh: &Mesh, repeat: usize) -> Value {
+    let options = StripifyOptions::default();
+    let ((ours, ms), (theirs, their_ms)) = interleaved_ms(
+        repeat,
+        || mts::stripify(mesh, &options),
+        || peers::meshopt::stripify(mesh),
+    );
+    let mut v = super::stats_json(&StripStats::new(&ours, ms));
+    v["meshopt"] = super::stats_json(&StripStats::new(&theirs, their_ms));
+    v
+}
+
+/// The whole contraction sequence (default options) against
+/// meshoptimizer's `simplify` to 10% and to 1% of the triangles, median
+/// milliseconds of interleaved runs.
+fn measure_simplify(mesh: &Mesh, repeat: usize) -> Value {
+    let n = mesh.triangle_count();
+    let ((whole, ms), (_, to_10)) = interleaved_ms(
+        repeat,
+        || mts::simplify(mesh, &SimplifyOptions::default()),
+        || peers::meshopt::simplify(mesh, n / 10),
+    );
+    let to_1 = time_us(1, || {
+        std::hint::black_box(peers::meshopt::simplify(mesh, n / 100));
+    }) / 1e3;
+    json!({
+        "ms": ms,
+        "max_lod": whole.collapses.max_lod(),
+        "stop": whole.stop.to_string(),
+        "meshopt_ms_to_10": to_10,
+        "meshopt_ms_to_1": to_1,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn measure_model(
+    name: &str,
+    mesh: &Mesh,
+    requests: usize,
+    repeat: usize,
+    renderer: &Figure6,
+    shares: &[f64],
+    frames: usize,
+) -> Result<(Value, MtsModel)> {
+    let (model, _, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let file_bytes = model.to_bytes().len();
+    let stats = model.stats();
+    let row = json!({
+        "name": name,
+        "triangles": mesh.triangle_count(),
+        "vertices": mesh.vertex_count(),
+        "strips": model.base_strips().run_count(),
+        "max_lod": model.max_lod(),
+        "bands": model.band_count(),
+        "bytes": {
+            "raw": model.raw_bytes(),
+            "raw_u16": model.raw_bytes_u16(),
+            "mts_file": file_bytes,
+            "mts_memory": stats.memory_bytes,
+        },
+        "build_ms": {
+            "stripify": ms(t.stripify),
+            "simplify": ms(t.simplify),
+            "model": ms(t.model),
+            "total": ms(t.total),
+        },
+        "stripify": measure_stripify(mesh, repeat),
+        "simplify": measure_simplify(mesh, repeat),
+        "extraction": measure_sequences(&model, requests),
+        "levels": measure_levels(&model),
+        "quality": measure_quality(mesh, &model),
+        "methods": super::measure_methods(&model, mesh, ms(t.total), requests)?,
+        "figure6": match renderer {
+            Ok(r) => r.measure(&model, mesh, shares, frames)?,
+            Err(_) => {
+                let _ = (shares, frames);
+                Value::Null
+            }
+        },
+    });
+    Ok((row, model))
+}
+
+/// Table 2: microseconds per LoD change over each sequence, with the
+/// coherence cache and from scratch: medians of five passes each, the two
+/// interleaved (a drift of the machine's speed hits both alike), each
+/// pass from a fresh extractor whose construction is not timed.
+fn measure_sequences(model: &MtsModel, requests: usize) -> Value {
+    let max_lod = model.max_lod();
+    let mut out = serde_json::Map::new();
+    for (seq, lods) in [
+        ("linear", sequence::linear(max_lod, requests)),
+        (
+            "exponential",
+            sequence::exponential(model.triangle_counts(), requests),
+        ),
+        ("random", sequence::random(max_lod, requests, 1)),
+    ] {
+        let n = lods.len().max(1) as f64;
+        let pass = |coherent: bool| {
+            let mut ex = Extractor::new(model);
+            let t = Instant::now();
+            for &l in &lods {
+                if coherent {
+                    ex.set_lod(l);
+                } else {
+                    ex.set_lod_from_scratch(l);
+                }
+            }
+            t.elapsed().as_secs_f64() * 1e6
+        };
+        let (mut coherent, mut scratch) = (Vec::new(), Vec::new());
+        for _ in 0..5 {
+            coherent.push(pass(true));
+            scratch.push(pass(false));
+        }
+        let (coherent, scratch) = (median(coherent), median(scratch));
+        out.insert(
+            seq.into(),
+            json!({
+                "requests": lods.len(),
+                "mts_coherent_us": coherent / n,
+                "mts_scratch_us": scratch / n,
+            }),
+        );
+    }
+    Value::Object(out)
+}
+
+/// Tables 3–4: indices sent at each share — MTS strips (restart values
+/// included), the triangle list, meshoptimizer's strips of that level's
+/// mesh — with ACMR (16-entry FIFO) of each order.
+pub fn measure_levels(model: &MtsModel) -> Value {
+    let mesh = model.mesh();
+    let mut ex = Extractor::new(model);
+    let mut compact = Vec::new();
+    let levels: Vec<Value> = SHARES
+        .iter()
+        .map(|&share| {
+            let lod = model.lod_for_ratio(share);
+            let us = time_us(5, || {
+                ex.set_lod_from_scratch(lod);
+            });
+            ex.write_compact(&mut compact);
+            let level = model.collapses().mesh_at(&mesh, lod);
+            let mut strip_triangles = Vec::new();
+            for run in compact.split(|&i| i == RESTART_U32) {
+                mts::strip::decode_run(run, &mut strip_triangles);
+            }
+            let vertices = model.positions().len();
+            let list_triangles =
+                peers::meshopt::optimize_vertex_cache(&level.triangles, level.vertex_count());
+            let theirs = peers::meshopt::stripify(&level);
+            let triangles = model.triangle_count(lod);
+            json!({
+                "share": share,
+                "lod": lod,
+                "triangles": triangles,
+                "extract_us": us,
+                "mts_indices": ex.indices_sent(),
+                "list_indices": 3 * triangles,
+                "meshopt_strip_indices": theirs.restart_index_count(),
+                "mts_acmr": fifo_acmr(&strip_triangles, vertices, CACHE_SIZE),
+                "list_acmr": fifo_acmr(&list_triangles, level.vertex_count(), CACHE_SIZE),
+                "meshopt_strip_acmr": fifo_acmr(&theirs.triangles(), level.vertex_count(), CACHE_SIZE),
+            })
+        })
+        .collect();
+    Value::Array(levels)
+}
+
+/// Hausdorff and RMS (relative to the diagonal) of the project's LoD and
+/// of meshoptimizer's `simplify` at the same triangle count.
+fn measure_quality(mesh: &Mesh, model: &MtsModel) -> Value {
+    let ours_mesh = model.mesh();
+    let rows: Vec<Value> = QUALITY_SHARES
+        .iter()
+        .map(|&share| {
+            // Compared at one triangle count, as `mts simplify` does: where
+            // meshoptimizer stops above ours, ours is taken at its count.
+            let t = Instant::now();
+            let (theirs, lod) = peers::meshopt::simplify_to_lod(
+                mesh,
+                model.collapses(),
+                model.lod_for_ratio(share),
+            );
+            let their_ms = t.elapsed().as_secs_f64() * 1e3;
+            let ours = model.collapses().mesh_at(&ours_mesh, lod);
+            let d = surface_distance(mesh.into(), (&ours).into(), SAMPLES);
+            let e = surface_distance(mesh.into(), Surface::over(mesh, &theirs), SAMPLES);
+            json!({
+                "share": share,
+                "mts": {"triangles": ours.triangle_count(), "hausdorff": d.hausdorff, "rms": d.rms},
+                "meshopt": {"triangles": theirs.len(), "hausdorff": e.hausdorff, "rms": e.rms, "ms": their_ms},
+            })
+        })
+        .collect();
+    Value::Array(rows)
+}
+
+/// Peak resident memory of this process so far (Linux), in bytes.
+fn peak_rss() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Build time, memory and extraction time of generated icospheres from
+/// 10K to 4M triangles, with the exponent of a power law fitted to each.
+fn measure_scale(progress: &dyn Fn(&str)) -> Value {
+    let mut rows = Vec::new();
+    for size in SCALE_SIZES {
+        let g: mts::mesh::generate::Generated = format!("icosphere:{size}")
+            .parse()
+            .expect("a valid generated name");
+        progress(&format!("scale icosphere:{size}"));
+        let mesh = g.build();
+        let (model, _, t) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
+        let mut ex = Extractor::new(&model);
+        let extract_us = time_us(5, || {
+            ex.set_lod_from_scratch(0);
+        });
+        let (model_bytes, rss) = (model.stats().memory_bytes, peak_rss());
+        drop(ex);
+        drop(model);
+        // Each stage alone (the pipeline runs stripify beside simplify),
+        // against meshoptimizer, one run each.
+        let ((_, stripify_ms), (_, meshopt_stripify_ms)) = interleaved_ms(
+            1,
+            || mts::stripify(&mesh, &StripifyOptions::default()),
+            || peers::meshopt::stripify(&mesh),
+        );
+        let n = mesh.triangle_count();
+        let ((_, simplify_ms), (_, meshopt_simplify_ms)) = interleaved_ms(
+            1,
+            || mts::simplify(&mesh, &SimplifyOptions::default()),
+            || peers::meshopt::simplify(&mesh, n / 10),
+        );
+        rows.push(json!({
+            "triangles": mesh.triangle_count(),
+            "stripify_ms": stripify_ms,
+            "meshopt_stripify_ms": meshopt_stripify_ms,
+            "simplify_ms": simplify_ms,
+            "meshopt_simplify_to_10_ms": meshopt_simplify_ms,
+            "build_ms": t.total.as_secs_f64() * 1e3,
+            "model_bytes": model_bytes,
+            "peak_rss_bytes": rss,
+            "extract_lod0_us": extract_us,
+        }));
+    }
+    let fit = |key: &str| {
+        let points: Vec<(f64, f64)> = rows
+            .iter()
+            .filter_map(|r| Some((r["triangles"].as_f64()?, r[key].as_f64()?)))
+            .filter(|&(x, y)| x > 0.0 && y > 0.0)
+            .map(|(x, y)| (x.ln(), y.ln()))
+            .collect();
+        growth_exponent(&points)
+    };
+    json!({
+        "rows": rows,
+        "exponent": {
+            "stripify_ms": fit("stripify_ms"),
+            "meshopt_stripify_ms": fit("meshopt_stripify_ms"),
+            "simplify_ms": fit("simplify_ms"),
+            "meshopt_simplify_to_10_ms": fit("meshopt_simplify_to_10_ms"),
+            "build_ms": fit("build_ms"),
+            "model_bytes": fit("model_bytes"),
+            "extract_lod0_us": fit("extract_lod0_us"),
+        },
+    })
+}
+
+/// Least-squares slope of `(ln x, ln y)` points: the exponent `k` of
+/// `y ~ x^k`.
+fn growth_exponent(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 2 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &(x, y)| (a + x, b + y));
+    let (mx, my) = (sx / n, sy / n);
+    let (num, den) = points.iter().fold((0.0, 0.0), |(a, b), &(x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    (den > 0.0).then(|| num / den)
+}
+
+/// The Skip Strips and MTS figures the MTS paper prints for the bunny
+/// (Tables 3 and 4, 550 MHz Pentium III): triangles, Skip Strips vertices,
+/// MTS vertices. A printed reference, not a measurement.
+const PAPER_TABLE_3: [(&str, &str, &str); 3] = [
+    ("10.2K", "22K", "23K"),
+    ("50.8K", "83K", "71K"),
+    ("69.4K", "92K", "83K"),
+];
+
+/// A JSON number, NaN when absent.
+pub fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap_or(f64::NAN)
+}
+
+/// The immediate-mode Figure 6 row of `method` at the share of `at`
+/// (`null` when not measured).
+pub fn figure6_row(rows: &[Value], at: &Value, method: &str) -> Value {
+    rows.iter()
+        .find(|y| y["share"] == at["share"] && y["method"] == method && y["mode"] == "immediate")
+        .cloned()
+        .unwrap_or(Value::Null)
+}
+
+/// The scale section's table and fitted exponents (the report's and the
+/// README's).
+pub fn scale_table(s: &mut String, results: &Value) {
+    let rows = results["scale"]["rows"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let _ = writeln!(s, "Stripify and simplify (whole sequence) each timed alone, beside meshoptimizer's `stripify` and `simplify` to 10%; build is the whole pipeline (stripify beside simplify, then the model).\n");
+    let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes | peak RSS bytes (process so far) | LoD 0 extraction µs |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    for r in &rows {
+        let _ = writeln!(
+            s,
+            "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} | {} | {:.0} |",
+            r["triangles"],
+            f(&r["stripify_ms"]),
+            f(&r["meshopt_stripify_ms"]),
+            f(&r["simplify_ms"]),
+            f(&r["meshopt_simplify_to_10_ms"]),
+            f(&r["build_ms"]),
+            r["model_bytes"],
+            r["peak_rss_bytes"],
+            f(&r["extract_lod0_us"]),
+        );
+    }
+    let e = &results["scale"]["exponent"];
+    let _ = writeln!(
+        s,
+        "\nFitted growth exponents (y ~ triangles^k): stripify {:.2} (meshoptimizer {:.2}), simplify {:.2} (meshoptimizer to 10% {:.2}), build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.",
+        f(&e["stripify_ms"]),
+        f(&e["meshopt_stripify_ms"]),
+        f(&e["simplify_ms"]),
+        f(&e["meshopt_simplify_to_10_ms"]),
+        f(&e["build_ms"]),
+        f(&e["model_bytes"]),
+        f(&e["extract_lod0_us"]),
+    );
+}
+
+/// The per-model strips table (the report's and the README's): the
+/// project's strips against meshoptimizer's on each input mesh.
+pub fn strips_table(s: &mut String, models: &[Value]) {
+    let _ = writeln!(
+        s, "The project's stripifier (adjacency included) against meshoptimizer's `optimize_vertex_cache_strip` + `stripify` on the input mesh, restart encoding; medians of interleaved runs. Each cell: mts / meshopt.\n");
+    let _ = writeln!(
+        s, "| model | triangles | strips | swaps | indices (restart) | indices per triangle | ACMR | ms |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    for r in models {
+        let (a, b) = (&r["stripify"], &r["stripify"]["meshopt"]);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} / {} | {} / {} | {} / {} | {:.4} / {:.4} | {:.3} / {:.3} | {:.1} / {:.1} |",
+            r["name"].as_str().unwrap_or("?"),
+            a["triangles"],
+            a["strips"],
+            b["strips"],
+            a["swaps"],
+            b["swaps"],
+            a["indices_restart"],
+            b["indices_restart"],
+            f(&a["indices_per_triangle"]),
+            f(&b["indices_per_triangle"]),
+            f(&a["acmr"]),
+            f(&b["acmr"]),
+            f(&a["ms"]),
+            f(&b["ms"]),
+        );
+    }
+}
+
+/// "CPU (N cores), OS" and the graphics adapter (or why there is none),
+/// for the report's and the README's first lines.
+pub fn machine_words(results: &Value) -> (String, String) {
+    let m = &results["machine"];
+    (
+        format!(
+            "{} ({} cores), {}",
+            m["cpu"].as_str().unwrap_or("?"),
+            m["cores"],
+            m["os"].as_str().unwrap_or("?")
+        ),
+        m["adapter"]
+            .as_str()
+            .or(m["adapter_note"].as_str())
+            .unwrap_or("none")
+            .to_string(),
+    )
+}
+
+/// `report.md` from the results.
+pub fn report(results: &Value) -> String {
+    let mut s = String::new();
+    let (machine, adapter) = machine_words(results);
+    let _ = writeln!(s, "# mts bench report\n");
+    let _ = writeln!(
+        s,
+        "Command: `{}`{}. Machine: {machine}. Graphics adapter (Figure 6): {adapter}.\n",
+        results["command"].as_str().unwrap_or(""),
+        results["elapsed_s"]
+            .as_f64()
+            .map_or_else(String::new, |e| format!(", {e:.0} s")),
+    );
+    let models = results["models"].as_array().cloned().unwrap_or_default();
+    let _ = writeln!(s, "## Table 1: models and sizes (bytes)\n");
+    let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | MTS in memory | build ms (stripify ‖ simplify, model, total) |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        let b = &r["bytes"];
+        let t = &r["build_ms"];
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
+            r["name"].as_str().unwrap_or("?"),
+            r["strips"],
+            r["triangles"],
+            r["vertices"],
+            f(&r["max_lod"]) as u64 + 1,
+            r["bands"],
+            b["raw"],
+            b["raw_u16"],
+            b["mts_file"],
+            f(&b["mts_file"]) / f(&b["raw"]),
+            b["mts_memory"],
+            f(&t["stripify"]),
+            f(&t["simplify"]),
+            f(&t["model"]),
+            f(&t["total"]),
+        );
+    }
+    let _ = writeln!(s, "\n## Strips against meshoptimizer\n");
+    strips_table(&mut s, &models);
+    let _ = writeln!(s, "\n### Table 1, every method: bytes and build time\n");
+    let _ = writeln!(s, "File bytes against the raw mesh with 16-bit indices (12 per vertex + 6 per triangle, the cluster-tree paper's reference). MTS builds the whole pipeline; the baselines start from the mesh and MTS's contraction sequence (the cluster tree makes its own clustering). Multilevel has no file format of its own: its figure is the in-memory structure.\n");
+    let _ = writeln!(
+        s,
+        "| model | method | file bytes | file / raw 16-bit | memory bytes | build ms |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    for r in &models {
+        for m in r["methods"].as_array().into_iter().flatten() {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.3} | {} | {:.0} |",
+                r["name"].as_str().unwrap_or("?"),
+                m["method"].as_str().unwrap_or("?"),
+                m["file_bytes"],
+                f(&m["file_ratio_to_raw_u16"]),
+                m["memory_bytes"],
+                f(&m["build_ms"]),
+            );
+        }
+    }
+    let _ = writeln!(s, "\n## Table 2: microseconds per LoD change\n");
+    let _ = writeln!(s, "Sequences of `mts::model::sequence` (linear: coarsest to finest in equal steps; exponential: triangle counts in geometric steps; random: uniform, seed 1); medians of five passes each, with and without coherence interleaved, each from a fresh extractor (its construction not timed).\n");
+    let _ = writeln!(s, "| model | linear coherent | linear without | × | exponential coherent | exponential without | × | random coherent | random without | × |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        let mut row = format!("| {} |", r["name"].as_str().unwrap_or("?"));
+        for seq in ["linear", "exponential", "random"] {
+            let e = &r["extraction"][seq];
+            let (c, w) = (f(&e["mts_coherent_us"]), f(&e["mts_scratch_us"]));
+            let _ = write!(row, " {c:.1} | {w:.1} | {:.1} |", w / c);
+        }
+        let _ = writeln!(s, "{row}");
+    }
+    let _ = writeln!(
+        s,
+        "\n### Table 2, every method: microseconds per LoD change\n"
+    );
+    let _ = writeln!(s, "Each method through `LodSource::set_lod` (MTS: the coherent extractor), the same sequences over its own LoD range, in one run. The cluster tree's LoDs are its own joins; discrete LoDs only switch buffers.\n");
+    let _ = writeln!(s, "| model | method | linear | exponential | random |");
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for r in &models {
+        for m in r["methods"].as_array().into_iter().flatten() {
+            let u = &m["us_per_change"];
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.1} | {:.1} | {:.1} |",
+                r["name"].as_str().unwrap_or("?"),
+                m["method"].as_str().unwrap_or("?"),
+                f(&u["linear"]),
+                f(&u["exponential"]),
+                f(&u["random"]),
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\n## Tables 3–4: indices sent per level (ACMR, 16-entry FIFO)\n"
+    );
+    let _ = writeln!(s, "MTS strips with restart values, the triangle list (`optimize_vertex_cache` order) and meshoptimizer's strips of that level's mesh (`optimize_vertex_cache_strip` + `stripify`), measured on the same LoD.\n");
+    let _ = writeln!(s, "| model | share | triangles | MTS indices | list indices | meshopt strip indices | MTS / meshopt | ACMR MTS / list / meshopt strips | extract µs (from scratch) |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        for l in r["levels"].as_array().into_iter().flatten() {
+            let _ = writeln!(
+                s,
+                "| {} | {:.0}% | {} | {} | {} | {} | {:.3} | {:.3} / {:.3} / {:.3} | {:.1} |",
+                r["name"].as_str().unwrap_or("?"),
+                f(&l["share"]) * 100.0,
+                l["triangles"],
+                l["mts_indices"],
+                l["list_indices"],
+                l["meshopt_strip_indices"],
+                f(&l["mts_indices"]) / f(&l["meshopt_strip_indices"]),
+                f(&l["mts_acmr"]),
+                f(&l["list_acmr"]),
+                f(&l["meshopt_strip_acmr"]),
+                f(&l["extract_us"]),
+            );
+        }
+    }
+    let _ = writeln!(s, "\nPrinted reference, not measured here: the MTS paper's Table 3 for the bunny (vertices sent): Skip Strips / MTS —");
+    for (t, skip, ours) in PAPER_TABLE_3 {
+        let _ = write!(s, " {t} triangles: {skip} / {ours};");
+    }
+    let _ = writeln!(
+        s,
+        "\n\n## Quality: simplification error against meshoptimizer\n"
+    );
+    let _ = writeln!(s, "Hausdorff and RMS distance to the input relative to its bounding-box diagonal ({SAMPLES} samples per side), meshoptimizer's `simplify` asked for the same triangle count (where it stops above it, the project's LoD is taken at its count).\n");
+    let peer = results["fast_simplification"].as_array();
+    if let Some(why) = results["fast_simplification"]["skipped"].as_str() {
+        let _ = writeln!(s, "fast-simplification not measured: {why}.\n");
+    }
+    let _ = writeln!(s, "Speed: the project's whole contraction sequence (every LoD, default options) against meshoptimizer's `simplify` to 10% and to 1%, medians of interleaved runs in milliseconds.\n");
+    let _ = writeln!(s, "| model | triangles | contractions | mts whole sequence | meshopt to 10% | meshopt to 1% | stopped |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    for r in &models {
+        let x = &r["simplify"];
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.1} | {:.1} | {:.1} | {} |",
+            r["name"].as_str().unwrap_or("?"),
+            r["triangles"],
+            x["max_lod"],
+            f(&x["ms"]),
+            f(&x["meshopt_ms_to_10"]),
+            f(&x["meshopt_ms_to_1"]),
+            x["stop"].as_str().unwrap_or("?"),
+        );
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts | Hausdorff meshopt | ratio | RMS mts | RMS meshopt | fast-simplification triangles, Hausdorff, RMS |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    for r in &models {
+        for q in r["quality"].as_array().into_iter().flatten() {
+            let fast = peer
+                .into_iter()
+                .flatten()
+                .find(|p| p["mesh"] == r["name"] && p["ratio"].as_f64() == q["share"].as_f64())
+                .map_or_else(
+                    || "—".to_string(),
+                    |p| {
+                        format!(
+                            "{}, {:.5}, {:.5}",
+                            p["triangles"],
+                            f(&p["hausdorff"]),
+                            f(&p["rms"])
+                        )
+                    },
+                );
+            let _ = writeln!(
+                s,
+                "| {} | {:.0}% | {} / {} | {:.5} | {:.5} | {:.2} | {:.5} | {:.5} | {fast} |",
+                r["name"].as_str().unwrap_or("?"),
+                f(&q["share"]) * 100.0,
+                q["mts"]["triangles"],
+                q["meshopt"]["triangles"],
+                f(&q["mts"]["hausdorff"]),
+                f(&q["meshopt"]["hausdorff"]),
+                f(&q["mts"]["hausdorff"]) / f(&q["meshopt"]["hausdorff"]),
+                f(&q["mts"]["rms"]),
+                f(&q["meshopt"]["rms"]),
+            );
+        }
+    }
+    if models.iter().any(|r| r["figure6"].is_object()) {
+        let _ = writeln!(
+            s,
+            "\n## Figure 6: frames per second against the share of triangles\n"
+        );
+        let _ = writeln!(s, "Immediate: a LoD change (extraction and upload) before every frame. Per second: one extraction (MTS from scratch; the list replayed and put in meshoptimizer's cache order) and upload per second, drawing in between. The list is meshoptimizer-ordered; MTS draws strips with primitive restart.\n");
+        let _ = writeln!(s, "Each cell: immediate / one extraction per second. The baselines (through `LodSource`) upload their whole index buffer per change and are asked for their finest LoD within the MTS level's triangles.\n");
+        let _ = writeln!(
+            s,
+            "| model | share | triangles | mts | list | pm | multilevel | cluster | discrete |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+        for r in &models {
+            let rows = r["figure6"]["rows"].as_array().cloned().unwrap_or_default();
+            let mut shares: Vec<f64> = Vec::new();
+            for x in &rows {
+                if let Some(v) = x["share"].as_f64() {
+                    if !shares.contains(&v) {
+                        shares.push(v);
+                    }
+                }
+            }
+            for share in shares {
+                let cell = |method: &str| {
+                    let fps = |mode: &str| {
+                        rows.iter()
+                            .find(|x| {
+                                x["share"].as_f64() == Some(share)
+                                    && x["method"] == method
+                                    && x["mode"] == mode
+                            })
+                            .map_or(f64::NAN, |x| f(&x["fps"]))
+                    };
+                    format!("{:.1} / {:.1}", fps("immediate"), fps("per_second"))
+                };
+                let triangles = rows
+                    .iter()
+                    .find(|x| x["share"].as_f64() == Some(share) && x["method"] == "mts")
+                    .map_or(Value::Null, |x| x["triangles"].clone());
+                let _ = writeln!(
+                    s,
+                    "| {} | {:.0}% | {} | {} | {} | {} | {} | {} | {} |",
+                    r["name"].as_str().unwrap_or("?"),
+                    share * 100.0,
+                    triangles,
+                    cell("mts"),
+                    cell("list"),
+                    cell("pm"),
+                    cell("multilevel"),
+                    cell("cluster"),
+                    cell("discrete"),
+                );
+            }
+        }
+    }
+    if models.iter().any(|r| r["figure6"].is_object()) {
+        let _ = writeln!(s, "\n### Figure 6, draw time per frame\n");
+        let _ = writeln!(s, "The same runs: the median time of one frame drawn without a LoD change (submit and wait), MTS strips against the meshoptimizer-ordered list, and the median time of one MTS LoD change (extraction and dirty-range upload, one LoD step back and forth).\n");
+        let _ = writeln!(s, "| model | share | triangles | indices mts / list | draw ms mts / list | Mtri/s mts / list | MTS LoD change µs |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+        for r in &models {
+            let rows = r["figure6"]["rows"].as_array().cloned().unwrap_or_default();
+            for x in rows
+                .iter()
+                .filter(|x| x["method"] == "mts" && x["mode"] == "immediate")
+            {
+                let list = figure6_row(&rows, x, "list");
+                let tri = f(&x["triangles"]);
+                let _ = writeln!(
+                    s,
+                    "| {} | {:.0}% | {} | {} / {} | {:.2} / {:.2} | {:.2} / {:.2} | {:.0} |",
+                    r["name"].as_str().unwrap_or("?"),
+                    f(&x["share"]) * 100.0,
+                    x["triangles"],
+                    x["indices_sent"],
+                    list["indices_sent"],
+                    f(&x["draw_ms"]),
+                    f(&list["draw_ms"]),
+                    tri / f(&x["draw_ms"]) / 1e3,
+                    tri / f(&list["draw_ms"]) / 1e3,
+                    f(&x["change_us"]),
+                );
+            }
+        }
+    }
+    let scene = &results["scene"];
+    if scene.is_object() {
+        let _ = writeln!(s, "\n## Scene: many instances, each with its own LoD\n");
+        let _ = writeln!(s, "`mts bench render`'s scene row on Figure 6's adapter: instances on a ground plane seen by the overview camera, culled by the instance BVH, each given the finest LoD with at most one triangle per 4 projected pixels and its own coherence cache. Frame: every instance's update and the draw, median.\n");
+        let _ = writeln!(s, "| model | instances | visible | triangles | indices sent | CPU bytes per instance | first update ms | ms per frame | fps | Mtri/s |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.2} |",
+            scene["model"].as_str().unwrap_or("?"),
+            scene["instances"],
+            scene["visible"],
+            scene["triangles"],
+            scene["indices_sent"],
+            scene["cpu_bytes_per_instance"],
+            f(&scene["ms_first_update"]),
+            f(&scene["ms_per_frame"]),
+            f(&scene["fps"]),
+            f(&scene["triangles_per_second"]) / 1e6,
+        );
+    }
+    if results["scale"]["rows"].is_array() {
+        let _ = writeln!(s, "\n## Scale: generated icospheres\n");
+        scale_table(&mut s, results);
+    }
+    s
+}
+
+/// Writes `report.md` and `results.json` into `dir` (created if needed).
+pub fn write(dir: &Path, results: &Value) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let json_path = dir.join("results.json");
+    std::fs::write(&json_path, serde_json::to_string_pretty(results)?)
+        .with_context(|| format!("cannot write {}", json_path.display()))?;
+    let charts = super::charts::write_all(dir, results)?;
+    let mut text = report(results);
+    if !charts.is_empty() {
+        let _ = writeln!(text, "\n## Charts\n");
+        for c in &charts {
+            if let Some(name) = c.file_name() {
+                let name = name.to_string_lossy();
+                let _ = writeln!(text, "![{name}]({name})\n");
+            }
+        }
+    }
+    let md = dir.join("report.md");
+    std::fs::write(&md, text).with_context(|| format!("cannot write {}", md.display()))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn growth_exponent_recovers_a_power_law() {
+        let points: Vec<(f64, f64)> = [1e4, 1e5, 1e6]
+            .iter()
+            .map(|&x: &f64| (x.ln(), (3.0 * x.powf(1.25)).ln()))
+            .collect();
+        let k = growth_exponent(&points).unwrap();
+        assert!((k - 1.25).abs() < 1e-9, "{k}");
+        assert_eq!(growth_exponent(&points[..1]), None);
+    }
+}

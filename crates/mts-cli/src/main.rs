@@ -1,0 +1,1531 @@
+//! The `mts` command: multiresolution triangle strips from the command line.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand};
+use mts::mesh::generate::Generated;
+use mts::mesh::io::{load, LoadOptions};
+use mts::mesh::{CleanOptions, CleanReport, Mesh};
+use mts::strip::stats::StripStats;
+use mts::{peers, stripify, StripifyOptions};
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+mod bench;
+mod bench_render;
+mod charts;
+mod demo;
+mod figure6;
+mod render;
+mod summary;
+mod viewer;
+
+#[derive(Parser)]
+#[command(
+    name = "mts",
+    version,
+    about = "Continuous level of detail with multiresolution triangle strips"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// The main job: build the model of the built-in mesh (or a file),
+    /// sweep its LoDs and print the side-by-side summary.
+    Demo(DemoArgs),
+    /// Cut a mesh into triangle strips and compare with meshoptimizer's.
+    Strips(StripsArgs),
+    /// Record the quadric-error contraction sequence, take one LoD of it and
+    /// measure its error beside meshoptimizer's simplify.
+    Simplify(SimplifyArgs),
+    /// Hausdorff and RMS distance of a mesh to a reference mesh.
+    Distance(DistanceArgs),
+    /// Write a mesh (a file or a generated one) as OBJ.
+    Convert(ConvertArgs),
+    /// Build the MTS model (strips, contraction sequence, per-strip graphs)
+    /// and write it as an .mts file.
+    Build(BuildArgs),
+    /// Describe an .mts file: sizes, bands, and strip quality at several
+    /// LoDs against stripifying that LoD's mesh from scratch.
+    Info(InfoArgs),
+    /// Extract one LoD of a model as restart-encoded strips.
+    Extract(ExtractArgs),
+    /// Encode a mesh as the cluster tree's packet stream (a progressive,
+    /// incrementally decodable file).
+    Encode(EncodeArgs),
+    /// Decode a packet stream, or only its first bytes (what a receiver
+    /// draws while the stream arrives).
+    Decode(DecodeArgs),
+    /// Every method side by side on one mesh: bytes, build time and
+    /// microseconds per LoD change on the linear, exponential and random
+    /// request sequences.
+    Compare(CompareArgs),
+    /// Check a model against the replay oracle and coherent against
+    /// from-scratch extraction; exits non-zero on any mismatch.
+    Verify(VerifyArgs),
+    /// Measure the MTS paper's tables on this machine: report.md and
+    /// results.json (`mts bench render`: render throughput alone).
+    Bench(BenchArgs),
+    /// Draw one LoD headless (Mesa's lavapipe without a GPU) into a PNG,
+    /// by the MTS strips or the oracle triangle list.
+    Render(render::RenderArgs),
+    /// Open a window on a model (orbit camera; wheel, Up/Down change the
+    /// LoD, A toggles the automatic LoD, Escape quits).
+    View(render::ViewArgs),
+}
+
+#[derive(Args)]
+struct DemoArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// Where the strip of thumbnails (PNG) goes.
+    #[arg(long, default_value = "demo-thumbnails.png")]
+    thumbnails: PathBuf,
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Frames and triangles per second: MTS strips against
+    /// meshoptimizer-ordered triangle lists at 100%, 50% and 10%.
+    Render(bench_render::BenchRenderArgs),
+    /// The README's "Latest bench report" section, made from a report's
+    /// results.json.
+    Summary(SummaryArgs),
+}
+
+#[derive(Args)]
+struct SummaryArgs {
+    /// The report's results.json.
+    results: PathBuf,
+    /// Rewrite this README's generated section in place.
+    #[arg(long)]
+    readme: Option<PathBuf>,
+    /// With --readme: change nothing, fail when the section differs from
+    /// what the results give.
+    #[arg(long, requires = "readme")]
+    check: bool,
+}
+
+fn bench_summary(args: &SummaryArgs) -> Result<()> {
+    let path = &args.results;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let results: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not a bench results.json", path.display()))?;
+    if results["schema"].as_u64() != Some(u64::from(bench::SCHEMA_VERSION)) {
+        bail!(
+            "{}: schema {} where this build reads {} (run mts bench again)",
+            path.display(),
+            results["schema"],
+            bench::SCHEMA_VERSION
+        );
+    }
+    let Some(readme) = &args.readme else {
+        let dir = path
+            .parent()
+            .map_or_else(String::new, |p| p.display().to_string());
+        print!("{}", summary::summary(&results, &dir));
+        return Ok(());
+    };
+    // Links are relative to the README.
+    let base = readme.parent().unwrap_or(std::path::Path::new(""));
+    let dir = path
+        .parent()
+        .map(|p| p.strip_prefix(base).unwrap_or(p).display().to_string())
+        .unwrap_or_default();
+    let section = summary::summary(&results, &dir);
+    let old = std::fs::read_to_string(readme)
+        .with_context(|| format!("cannot read {}", readme.display()))?;
+    let Some(new) = summary::splice(&old, &section) else {
+        bail!(
+            "{} has no generated section: put the two lines\n{}\n{}\nwhere it goes",
+            readme.display(),
+            summary::BEGIN,
+            summary::END
+        );
+    };
+    if args.check {
+        if new != old {
+            bail!(
+                "{}'s bench section differs from {}: run `mts bench summary {} --readme {}`",
+                readme.display(),
+                path.display(),
+                path.display(),
+                readme.display()
+            );
+        }
+        println!("{} matches {}", readme.display(), path.display());
+        return Ok(());
+    }
+    std::fs::write(readme, new).with_context(|| format!("cannot write {}", readme.display()))?;
+    println!("rewrote the bench section of {}", readme.display());
+    Ok(())
+}
+
+#[derive(Args)]
+#[command(args_conflicts_with_subcommands = true)]
+struct BenchArgs {
+    #[command(subcommand)]
+    command: Option<BenchCommand>,
+    /// Meshes, or folders whose .obj and .ply files are all measured.
+    /// Default: ../shared/models when it exists, else the built-in mesh.
+    #[arg(long, num_args = 1..)]
+    models: Vec<PathBuf>,
+    /// Where report.md and results.json go.
+    #[arg(long, default_value = "bench-report")]
+    out: PathBuf,
+    /// The built-in mesh only, fewer requests, no scale section (a smoke
+    /// test of under two minutes).
+    #[arg(long)]
+    quick: bool,
+    /// Skip Figure 6 (frames per second through the headless renderer).
+    #[arg(long)]
+    no_render: bool,
+}
+
+fn bench_cmd(args: &BenchArgs) -> Result<()> {
+    match &args.command {
+        Some(BenchCommand::Render(args)) => return bench_render::bench_render(args),
+        Some(BenchCommand::Summary(args)) => return bench_summary(args),
+        None => {}
+    }
+    let mut models = Vec::new();
+    let mut sources = args.models.clone();
+    if sources.is_empty() && !args.quick {
+        let shared = PathBuf::from("../shared/models");
+        if shared.is_dir() {
+            sources.push(shared);
+        }
+    }
+    for p in sources {
+        if p.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(&p)
+                .with_context(|| format!("cannot read {}", p.display()))?
+                .flatten()
+                .map(|e| e.path())
+                .filter(|f| f.extension().is_some_and(|x| x == "obj" || x == "ply"))
+                .collect();
+            found.sort();
+            models.extend(found);
+        } else {
+            models.push(p);
+        }
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let t = Instant::now();
+    let options = bench::BenchOptions {
+        models,
+        quick: args.quick,
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        render: !args.no_render,
+    };
+    let mut results = bench::run(&options, &|what| {
+        bar.set_message(format!("measuring {what}"))
+    })?;
+    results["elapsed_s"] = json!(t.elapsed().as_secs_f64());
+    bar.finish_and_clear();
+    bench::write(&args.out, &results)?;
+    println!(
+        "wrote {} and {} in {:.0} s",
+        args.out.join("report.md").display(),
+        args.out.join("results.json").display(),
+        t.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+#[derive(Args)]
+struct BuildArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// The .mts file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Start a new band of strips when they send this much more indices per
+    /// triangle than at the band's start (see BuildOptions::band_slack).
+    #[arg(allow_negative_numbers = true, long, default_value_t = mts::model::DEFAULT_BAND_SLACK,
+          value_parser = band_slack)]
+    band_slack: f64,
+    /// One band only: the paper's model, whose strips degrade as the mesh
+    /// is simplified.
+    #[arg(long, conflicts_with = "band_slack")]
+    single_band: bool,
+    /// Optimal placement in the contraction sequence (new vertices).
+    #[arg(long)]
+    optimal: bool,
+}
+
+impl BuildArgs {
+    fn pipeline_options(&self) -> mts::model::PipelineOptions {
+        use mts::simplify::{Placement, SimplifyOptions};
+        mts::model::PipelineOptions {
+            simplify: SimplifyOptions {
+                placement: if self.optimal {
+                    Placement::Optimal
+                } else {
+                    Placement::Endpoint
+                },
+                ..SimplifyOptions::default()
+            },
+            build: mts::model::BuildOptions {
+                band_slack: if self.single_band {
+                    f64::INFINITY
+                } else {
+                    self.band_slack
+                },
+                ..mts::model::BuildOptions::default()
+            },
+            ..Default::default()
+        }
+    }
+}
+
+#[derive(Args)]
+struct InfoArgs {
+    /// The .mts file.
+    model: PathBuf,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Where a mesh comes from: a file or a built-in generator.
+#[derive(Args)]
+struct MeshSource {
+    /// OBJ or PLY file (or an .mts model, for the commands that read a
+    /// model).
+    #[arg(conflicts_with = "generated")]
+    mesh: Option<PathBuf>,
+    /// Built-in mesh NAME:SIZE, SIZE in triangles (k/M suffixes):
+    /// icosphere:100k, torus:1M, grid:20k. The default when no file is given.
+    #[arg(long, value_name = "NAME:SIZE")]
+    generated: Option<Generated>,
+    /// Merge vertices with identical positions.
+    #[arg(long)]
+    weld: bool,
+}
+
+impl MeshSource {
+    /// The model to read: an `.mts` file (recognised by its magic bytes),
+    /// or the model of the mesh, built first with the default options (a
+    /// progress bar on large inputs).
+    fn model(&self) -> Result<(String, mts::MtsModel)> {
+        if let Some(path) = &self.mesh {
+            let is_mts = std::fs::File::open(path)
+                .and_then(|mut f| {
+                    use std::io::Read;
+                    let mut magic = [0u8; 8];
+                    f.read_exact(&mut magic)
+                        .map(|()| &magic == mts::model::format::MAGIC)
+                })
+                .unwrap_or(false);
+            if is_mts {
+                let model = mts::MtsModel::load(path)?;
+                return Ok((path.display().to_string(), model));
+            }
+        }
+        let (name, mesh, _) = self.load()?;
+        let (model, _, _) = build_with_bar(&mesh, &Default::default());
+        Ok((name, model))
+    }
+
+    fn load(&self) -> Result<(String, Mesh, CleanReport)> {
+        let clean = CleanOptions { weld: self.weld };
+        if let Some(path) = &self.mesh {
+            let (mesh, report) =
+                load(path, LoadOptions { clean }).context("cannot load the mesh")?;
+            Ok((path.display().to_string(), mesh, report))
+        } else {
+            let g = self.generated.unwrap_or(Generated::DEFAULT);
+            let mesh = g.build();
+            let raw = mts::mesh::RawMesh {
+                positions: mesh.positions,
+                triangles: mesh.triangles,
+                degenerate_in_source: 0,
+            };
+            let (mesh, report) = mts::mesh::clean(raw, clean, &g.to_string())?;
+            Ok((format!("generated {g}"), mesh, report))
+        }
+    }
+}
+
+#[derive(Args)]
+struct StripsArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Timed repetitions (1 to 10,000); the median is reported.
+    #[arg(long, default_value_t = 5, value_parser = count_in::<1, MAX_REPEAT>, allow_negative_numbers = true)]
+    repeat: usize,
+    /// Skip the global quadrilateral-patch pass.
+    #[arg(long)]
+    no_patches: bool,
+    /// Smallest patch kept by the global pass, in quads.
+    #[arg(long)]
+    min_patch: Option<usize>,
+    /// Only this swap penalty in the local pass (see StripifyOptions).
+    #[arg(allow_negative_numbers = true, long, value_parser = non_negative::<f32>)]
+    swap_penalty: Option<f32>,
+    /// Do not join strips whose ends are neighbours.
+    #[arg(long)]
+    no_join: bool,
+}
+
+#[derive(Args)]
+#[command(group(clap::ArgGroup::new("target").required(true).args(["ratio", "triangles"])))]
+struct SimplifyArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// Keep this share of the triangles (0..1).
+    #[arg(allow_negative_numbers = true, long)]
+    ratio: Option<f64>,
+    /// Keep at most this many triangles.
+    #[arg(allow_negative_numbers = true, long)]
+    triangles: Option<usize>,
+    /// Write the simplified mesh as OBJ.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Place each surviving vertex at the quadric's optimum (new vertices)
+    /// instead of keeping an endpoint.
+    #[arg(long)]
+    optimal: bool,
+    /// Also contract vertex pairs closer than this share of the diagonal.
+    #[arg(allow_negative_numbers = true, long, value_name = "SHARE", value_parser = non_negative::<f32>)]
+    pair_distance: Option<f32>,
+    /// Weight of the boundary-preserving planes.
+    #[arg(allow_negative_numbers = true, long, value_parser = non_negative::<f64>)]
+    boundary_weight: Option<f64>,
+    /// Surface samples per side for the error measurement.
+    #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES, value_parser = count_in::<1, MAX_SAMPLES>, allow_negative_numbers = true)]
+    samples: usize,
+    /// Skip meshoptimizer.
+    #[arg(long)]
+    no_meshopt: bool,
+}
+
+#[derive(Args)]
+struct DistanceArgs {
+    /// The reference mesh (errors are relative to its bounding-box diagonal).
+    reference: PathBuf,
+    /// The mesh measured against it.
+    other: PathBuf,
+    /// Surface samples per side.
+    #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES, value_parser = count_in::<1, MAX_SAMPLES>, allow_negative_numbers = true)]
+    samples: usize,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct ConvertArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// The OBJ file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+/// A count argument in `MIN..=MAX`: what clap calls for `--repeat`,
+/// `--samples`, `--requests`, `--frames` and `--scene`, so that no
+/// allocation or loop is sized by an absurd number, and a negative or
+/// fractional one is named as such.
+pub(crate) fn count_in<const MIN: u64, const MAX: u64>(
+    s: &str,
+) -> std::result::Result<usize, String> {
+    let n: i128 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a whole number (expected {MIN} to {MAX})"))?;
+    if n < i128::from(MIN) || n > i128::from(MAX) {
+        return Err(format!("{n} is outside {MIN}..={MAX}"));
+    }
+    Ok(n as usize)
+}
+
+/// `--band-slack`: a number of at least [`mts::model::MIN_BAND_SLACK`]
+/// (`inf` is one band, as `--single-band`).
+fn band_slack(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if v >= mts::model::MIN_BAND_SLACK {
+        Ok(v)
+    } else {
+        Err(format!(
+            "{v} is below the smallest slack, {} (use --single-band for one band)",
+            mts::model::MIN_BAND_SLACK
+        ))
+    }
+}
+
+/// A finite number of at least 0 (weights and distances).
+fn non_negative<T: std::str::FromStr + Into<f64> + Copy>(
+    s: &str,
+) -> std::result::Result<T, String> {
+    let v: T = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    let x: f64 = v.into();
+    if x.is_finite() && x >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{x} is not a finite number of at least 0"))
+    }
+}
+
+/// Most timed repetitions `--repeat` takes.
+const MAX_REPEAT: u64 = 10_000;
+/// Most surface samples per side `--samples` takes (about 1 GB of points).
+const MAX_SAMPLES: u64 = 20_000_000;
+/// Most requests per sequence `compare --requests` takes.
+const MAX_REQUESTS: u64 = 10_000_000;
+
+fn median_ms<T>(repeat: usize, mut f: impl FnMut() -> T) -> (T, f64) {
+    let mut times = Vec::with_capacity(repeat.max(1));
+    let mut out = None;
+    for _ in 0..repeat.max(1) {
+        let t = Instant::now();
+        let r = f();
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        out = Some(r);
+    }
+    times.sort_by(f64::total_cmp);
+    (out.expect("at least one run"), times[times.len() / 2])
+}
+
+fn stats_json(s: &StripStats) -> serde_json::Value {
+    json!({
+        "triangles": s.triangles,
+        "strips": s.strips,
+        "swaps": s.swaps,
+        "indices_restart": s.indices_restart,
+        "indices_per_triangle": s.indices_per_triangle,
+        "acmr": s.acmr,
+        "ms": s.ms,
+    })
+}
+
+fn strips(args: &StripsArgs) -> Result<()> {
+    let (name, mesh, report) = args.source.load()?;
+    let defaults = StripifyOptions::default();
+    let options = StripifyOptions {
+        patches: !args.no_patches,
+        min_patch_quads: args.min_patch.unwrap_or(defaults.min_patch_quads),
+        swap_penalties: match args.swap_penalty {
+            Some(p) => [Some(p), None],
+            None => defaults.swap_penalties,
+        },
+        join_ends: !args.no_join,
+    };
+    let (ours, ms) = median_ms(args.repeat, || stripify(&mesh, &options));
+    let skipped = peers::meshopt::refusal(&mesh);
+    let peer = skipped.is_none().then(|| {
+        let (theirs, their_ms) = median_ms(args.repeat, || peers::meshopt::stripify(&mesh));
+        StripStats::new(&theirs, their_ms)
+    });
+    let mine = StripStats::new(&ours, ms);
+    // The invariant, checked on every run: a wrong strip is never reported.
+    if mts::strip::sorted_canonical(&ours.triangles())
+        != mts::strip::sorted_canonical(&mesh.triangles)
+    {
+        bail!("internal error: the strips do not draw exactly the mesh's triangles");
+    }
+    if args.json {
+        let mut v = stats_json(&mine);
+        v["meshopt"] = peer.as_ref().map_or(serde_json::Value::Null, stats_json);
+        if let Some(why) = &skipped {
+            v["meshopt_skipped"] = json!(why);
+        }
+        v["mesh"] = json!(name);
+        v["vertices"] = json!(mesh.vertex_count());
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!(
+        "{name}: {} vertices, {} triangles ({} degenerate and {} unreferenced dropped, {} welded)",
+        mesh.vertex_count(),
+        mesh.triangle_count(),
+        report.degenerate_dropped,
+        report.unreferenced_dropped,
+        report.welded
+    );
+    if let Some(why) = &skipped {
+        println!("{why}");
+    }
+    println!("{:<22}{:>14}{:>14}", "", "mts", "meshopt");
+    let peer = peer.unwrap_or_default();
+    let rows: [(&str, String, String); 7] = [
+        (
+            "triangles",
+            mine.triangles.to_string(),
+            peer.triangles.to_string(),
+        ),
+        ("strips", mine.strips.to_string(), peer.strips.to_string()),
+        ("swaps", mine.swaps.to_string(), peer.swaps.to_string()),
+        (
+            "indices (restart)",
+            mine.indices_restart.to_string(),
+            peer.indices_restart.to_string(),
+        ),
+        (
+            "indices / triangle",
+            format!("{:.4}", mine.indices_per_triangle),
+            format!("{:.4}", peer.indices_per_triangle),
+        ),
+        (
+            "ACMR (cache 16)",
+            format!("{:.3}", mine.acmr),
+            format!("{:.3}", peer.acmr),
+        ),
+        (
+            "ms (median)",
+            format!("{:.2}", mine.ms),
+            format!("{:.2}", peer.ms),
+        ),
+    ];
+    for (label, a, b) in rows {
+        println!("{label:<22}{a:>14}{b:>14}");
+    }
+    Ok(())
+}
+
+fn simplify(args: &SimplifyArgs) -> Result<()> {
+    use mts::distance::{surface_distance, Surface};
+    use mts::simplify::{Placement, SimplifyOptions};
+    let (name, mesh, _) = args.source.load()?;
+    let input = mesh.triangle_count();
+    let target = match (args.triangles, args.ratio) {
+        (Some(n), _) => n,
+        (None, Some(r)) if (0.0..=1.0).contains(&r) => (r * input as f64).round() as usize,
+        (None, Some(r)) => bail!("--ratio must be between 0 and 1, not {r}"),
+        (None, None) => bail!("give --ratio or --triangles"),
+    };
+    let defaults = SimplifyOptions::default();
+    let mut options = SimplifyOptions {
+        placement: if args.optimal {
+            Placement::Optimal
+        } else {
+            Placement::Endpoint
+        },
+        pair_distance: args.pair_distance,
+        boundary_weight: args.boundary_weight.unwrap_or(defaults.boundary_weight),
+        stop_at_triangles: None,
+    };
+    let t = Instant::now();
+    let whole = mts::simplify(&mesh, &options);
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    options.stop_at_triangles = Some(target);
+    let t = Instant::now();
+    let partial = mts::simplify(&mesh, &options);
+    let ms_to_target = t.elapsed().as_secs_f64() * 1e3;
+    let collapses = &whole.collapses;
+    let mut lod = collapses.lod_for_triangles(target);
+    // The early-stopped run must be a prefix of the whole sequence.
+    if partial.collapses.steps() != &collapses.steps()[..partial.collapses.max_lod()] {
+        bail!("internal error: the sequence stopped at the target differs from the whole one");
+    }
+    // Compare at one triangle count: ours at the target, meshoptimizer
+    // asked for the same; when it stops above it, ours at its count.
+    let mut peer_triangles = None;
+    let skipped = peers::meshopt::refusal(&mesh);
+    if let Some(why) = &skipped {
+        eprintln!("{name}: {why}");
+    }
+    if !args.no_meshopt && skipped.is_none() {
+        let ((theirs, at), their_ms) =
+            median_ms(1, || peers::meshopt::simplify_to_lod(&mesh, collapses, lod));
+        lod = at;
+        peer_triangles = Some((theirs, their_ms));
+    }
+    let triangles = collapses.triangles_at(&mesh, lod);
+    let positions: Vec<glam::Vec3> = mesh
+        .positions
+        .iter()
+        .chain(collapses.appended())
+        .copied()
+        .collect();
+    let ours = Surface {
+        positions: &positions,
+        triangles: &triangles,
+    };
+    let d = surface_distance((&mesh).into(), ours, args.samples);
+    let mut peer = serde_json::Value::Null;
+    if let Some((theirs, their_ms)) = peer_triangles {
+        let td = surface_distance((&mesh).into(), Surface::over(&mesh, &theirs), args.samples);
+        peer = json!({
+            "triangles": theirs.len(),
+            "ms": their_ms,
+            "hausdorff": td.hausdorff,
+            "rms": td.rms,
+        });
+    }
+    if let Some(path) = &args.output {
+        mts::mesh::io::save_obj(&collapses.mesh_at(&mesh, lod), path)?;
+    }
+    let v = json!({
+        "mesh": name,
+        "input_triangles": input,
+        "target": target,
+        "triangles": triangles.len(),
+        "lod": lod,
+        "max_lod": collapses.max_lod(),
+        "ms": ms,
+        "ms_to_target": ms_to_target,
+        "quadric_error": collapses.error(lod),
+        "hausdorff": d.hausdorff,
+        "rms": d.rms,
+        "stop": whole.stop.to_string(),
+        "meshopt": peer,
+    });
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!(
+        "{name}: {input} triangles -> target {target}; sequence of {} contractions, {}",
+        collapses.max_lod(),
+        whole.stop
+    );
+    println!("{:<26}{:>14}{:>14}", "", "mts", "meshopt");
+    let peer = &v["meshopt"];
+    let show = |x: &serde_json::Value, digits: usize| {
+        x.as_f64()
+            .map_or_else(|| "-".to_string(), |x| format!("{x:.digits$}"))
+    };
+    let rows = [
+        (
+            "triangles",
+            show(&v["triangles"], 0),
+            show(&peer["triangles"], 0),
+        ),
+        (
+            "ms (to target)",
+            format!("{ms_to_target:.1}"),
+            show(&peer["ms"], 1),
+        ),
+        (
+            "Hausdorff / diagonal",
+            show(&v["hausdorff"], 6),
+            show(&peer["hausdorff"], 6),
+        ),
+        ("RMS / diagonal", show(&v["rms"], 6), show(&peer["rms"], 6)),
+    ];
+    for (label, mine, theirs) in rows {
+        println!("{label:<26}{mine:>14}{theirs:>14}");
+    }
+    println!("{:<26}{:>14.1}", "ms (whole sequence)", ms);
+    Ok(())
+}
+
+fn distance(args: &DistanceArgs) -> Result<()> {
+    let options = LoadOptions::default();
+    let (a, _) = load(&args.reference, options).context("cannot load the reference")?;
+    let (b, _) = load(&args.other, options).context("cannot load the measured mesh")?;
+    let d = mts::distance::surface_distance((&a).into(), (&b).into(), args.samples);
+    if args.json {
+        let v = json!({
+            "reference_triangles": a.triangle_count(),
+            "triangles": b.triangle_count(),
+            "hausdorff": d.hausdorff,
+            "rms": d.rms,
+            "forward": d.forward,
+            "backward": d.backward,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "Hausdorff {:.6}  RMS {:.6}  (relative to the reference's diagonal; \
+             reference -> other {:.6}, other -> reference {:.6})",
+            d.hausdorff, d.rms, d.forward, d.backward
+        );
+    }
+    Ok(())
+}
+
+fn convert(args: &ConvertArgs) -> Result<()> {
+    let (_, mesh, _) = args.source.load()?;
+    mts::mesh::io::save_obj(&mesh, &args.output)?;
+    Ok(())
+}
+
+fn run(cli: &Cli) -> Result<()> {
+    match &cli.command {
+        Command::Strips(args) => strips(args),
+        Command::Simplify(args) => simplify(args),
+        Command::Distance(args) => distance(args),
+        Command::Convert(args) => convert(args),
+        Command::Build(args) => build(args),
+        Command::Info(args) => info(args),
+        Command::Extract(args) => extract(args),
+        Command::Bench(args) => bench_cmd(args),
+        Command::Demo(args) => {
+            let (name, mesh, _) = args.source.load()?;
+            demo::run(&name, &mesh, &args.thumbnails)
+        }
+        Command::Encode(args) => encode(args),
+        Command::Decode(args) => decode(args),
+        Command::Compare(args) => compare(args),
+        Command::Verify(args) => {
+            if verify(args)? {
+                Ok(())
+            } else {
+                bail!("the model breaks the invariant (see above)")
+            }
+        }
+        Command::Render(args) => render::render(args),
+        Command::View(args) => render::view(args),
+    }
+}
+
+/// Inputs of this many triangles or more get a progress bar.
+const PROGRESS_MIN_TRIANGLES: usize = 200_000;
+
+fn build(args: &BuildArgs) -> Result<()> {
+    let (name, mesh, _) = args.source.load()?;
+    let options = args.pipeline_options();
+    let (model, _, t) = build_with_bar(&mesh, &options);
+    let bytes = model.to_bytes();
+    std::fs::write(&args.output, &bytes)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let st = model.stats();
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "vertices": mesh.vertex_count(),
+                "triangles": mesh.triangle_count(),
+                "max_lod": model.max_lod(),
+                "strips": st.strips,
+                "bytes": bytes.len(),
+                "raw_bytes": model.raw_bytes(),
+                "bands": model.band_count(),
+                "nodes": st.nodes,
+                "arcs": st.arcs,
+                "memory_bytes": st.memory_bytes,
+                "ms_stripify": ms(t.stripify),
+                "ms_simplify": ms(t.simplify),
+                "ms_model": ms(t.model),
+                "ms": ms(t.total),
+            })
+        );
+    } else {
+        println!(
+            "{name}: {} triangles, {} vertices, {} LoDs",
+            mesh.triangle_count(),
+            mesh.vertex_count(),
+            model.max_lod() + 1
+        );
+        println!(
+            "  time      stripify {:.1} ms beside simplify {:.1} ms, model {:.1} ms, total {:.1} ms",
+            ms(t.stripify),
+            ms(t.simplify),
+            ms(t.model),
+            ms(t.total)
+        );
+        println!(
+            "  model     {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
+            model.band_count(),
+            st.strips,
+            st.nodes,
+            st.arcs,
+            st.memory_bytes as f64 / 1e6
+        );
+        println!(
+            "  file      {} bytes = {:.2} x raw ({} bytes: 12 per vertex + 12 per triangle) -> {}",
+            bytes.len(),
+            bytes.len() as f64 / model.raw_bytes() as f64,
+            model.raw_bytes(),
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+/// The whole pipeline with a progress bar on large inputs.
+fn build_with_bar(
+    mesh: &Mesh,
+    options: &mts::model::PipelineOptions,
+) -> (
+    mts::MtsModel,
+    mts::simplify::Stop,
+    mts::model::PipelineTimings,
+) {
+    use indicatif::{ProgressBar, ProgressStyle};
+    let bar = if mesh.triangle_count() >= PROGRESS_MIN_TRIANGLES {
+        ProgressBar::new(1)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg:16} [{bar:30}] {pos}/{len} {elapsed}")
+            .expect("valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar.set_message("strips + QEM");
+    let mut started = false;
+    let out = mts::model::build_from_mesh(mesh, options, &mut |done, max_lod| {
+        if !started {
+            bar.set_message("graphs (LoDs)");
+            bar.set_length(max_lod.max(1) as u64);
+            started = true;
+        }
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    out
+}
+
+/// Which LoD a command reads: by number, triangle budget or share.
+#[derive(Args)]
+#[command(group(clap::ArgGroup::new("level").args(["lod", "triangles", "ratio"])))]
+struct LevelArgs {
+    /// The LoD (0 is the full mesh; clamped to the last).
+    #[arg(allow_negative_numbers = true, long)]
+    lod: Option<usize>,
+    /// The finest LoD with at most this many triangles.
+    #[arg(allow_negative_numbers = true, long)]
+    triangles: Option<usize>,
+    /// The LoD with this share of the full triangle count (0..1).
+    #[arg(allow_negative_numbers = true, long)]
+    ratio: Option<f64>,
+}
+
+impl LevelArgs {
+    /// The LoD asked for in `source`'s own numbering (`None` when none
+    /// was given). See [`LevelArgs::resolve_in`].
+    fn resolve(&self, source: &dyn mts::LodSource) -> Result<Option<usize>> {
+        self.resolve_in(source.max_lod(), source.triangle_count(0), |n| {
+            mts::lod::lod_for_triangles(source, n)
+        })
+    }
+
+    /// The LoD of an MTS model (its own triangle table; no extractor).
+    fn resolve_model(&self, model: &mts::MtsModel) -> Result<Option<usize>> {
+        self.resolve_in(model.max_lod(), model.triangle_count(0), |n| {
+            model.lod_for_triangles(n)
+        })
+    }
+
+    /// The LoD from `max_lod`, the full triangle count and the finest LoD
+    /// within a budget: a share is the budget `ratio × full`, answered like
+    /// `--triangles`; a LoD past the last is clamped.
+    fn resolve_in(
+        &self,
+        max_lod: usize,
+        full: usize,
+        lod_for_triangles: impl Fn(usize) -> usize,
+    ) -> Result<Option<usize>> {
+        Ok(match (self.lod, self.triangles, self.ratio) {
+            (Some(l), _, _) => Some(l.min(max_lod)),
+            (_, Some(n), _) => Some(lod_for_triangles(n)),
+            (_, _, Some(r)) => {
+                if !(0.0..=1.0).contains(&r) {
+                    bail!("--ratio must be between 0 and 1, not {r}");
+                }
+                Some(lod_for_triangles((r * full as f64).round() as usize))
+            }
+            _ => None,
+        })
+    }
+}
+
+#[derive(Args)]
+struct ExtractArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    #[command(flatten)]
+    level: LevelArgs,
+    /// Write the extracted triangles as OBJ.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Timed extractions from scratch (1 to 10,000); the median is reported.
+    #[arg(long, default_value_t = 11, value_parser = count_in::<1, MAX_REPEAT>, allow_negative_numbers = true)]
+    repeat: usize,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// The method extracting the LoD: mts (strips) or a baseline. The
+    /// cluster tree has its own clustering, so its LoD k differs; use
+    /// --triangles or --ratio to compare methods.
+    #[arg(long, value_enum, default_value_t = Method::Mts)]
+    method: Method,
+}
+
+/// The LoD methods (`LodSource` implementations).
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Method {
+    /// Multiresolution triangle strips.
+    Mts,
+    /// Progressive mesh (Hoppe 1996).
+    Pm,
+    /// Progressive multilevel mesh.
+    Multilevel,
+    /// Cluster tree.
+    Cluster,
+    /// meshoptimizer simplify at fixed ratios.
+    Discrete,
+}
+
+impl Method {
+    const ALL: [Method; 5] = [
+        Method::Mts,
+        Method::Pm,
+        Method::Multilevel,
+        Method::Cluster,
+        Method::Discrete,
+    ];
+}
+
+/// The source of `method` over `model` (its mesh and contraction sequence).
+fn make_source<'m>(
+    method: Method,
+    model: &'m mts::MtsModel,
+    mesh: &Mesh,
+) -> Result<Box<dyn mts::LodSource + 'm>> {
+    use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
+    let c = model.collapses();
+    Ok(match method {
+        Method::Mts => Box::new(mts::Extractor::new(model)),
+        Method::Pm => Box::new(ProgressiveMesh::new(mesh, c)?),
+        Method::Multilevel => Box::new(MultilevelMesh::new(mesh, c)?),
+        Method::Cluster => Box::new(ClusterTree::new(mesh)?),
+        Method::Discrete => {
+            if let Some(why) = peers::meshopt::refusal(mesh) {
+                bail!("the discrete LoDs are meshoptimizer's simplify: {why}");
+            }
+            Box::new(DiscreteLods::new(mesh, c.triangle_counts()))
+        }
+    })
+}
+
+fn extract(args: &ExtractArgs) -> Result<()> {
+    use mts::Extractor;
+    if args.method != Method::Mts {
+        return extract_baseline(args);
+    }
+    let (name, model) = args.source.model()?;
+    let lod = args
+        .level
+        .resolve_model(&model)?
+        .context("give --lod, --triangles or --ratio")?;
+    // Each timed extraction starts from an empty extractor (no coherence).
+    let mut times = Vec::with_capacity(args.repeat.max(1));
+    let mut ex = Extractor::new(&model);
+    for _ in 0..args.repeat.max(1) {
+        ex = Extractor::new(&model);
+        let t = Instant::now();
+        ex.set_lod(lod);
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    times.sort_by(f64::total_cmp);
+    let us = times[times.len() / 2];
+    let mut compact = Vec::new();
+    ex.write_compact(&mut compact);
+    let runs = compact
+        .split(|&i| i == mts::strip::encode::RESTART_U32)
+        .filter(|r| !r.is_empty())
+        .count();
+    let triangles = model.triangle_count(lod);
+    if let Some(out) = &args.output {
+        let mesh = Mesh {
+            positions: model.positions().to_vec(),
+            triangles: ex.triangles(),
+        };
+        mts::mesh::io::save_obj(&mesh, out)?;
+    }
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "lod": lod,
+                "max_lod": model.max_lod(),
+                "triangles": triangles,
+                "strips": runs,
+                "indices": ex.indices_sent(),
+                "indices_per_triangle": ex.indices_sent() as f64 / triangles.max(1) as f64,
+                "us": us,
+            })
+        );
+    } else {
+        println!(
+            "{name}: LoD {lod} of {}: {triangles} triangles in {runs} strips, {} indices sent ({:.3} per triangle), extracted in {us:.1} us (median of {} from scratch)",
+            model.max_lod(),
+            ex.indices_sent(),
+            ex.indices_sent() as f64 / triangles.max(1) as f64,
+            times.len()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+struct VerifyArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// `all`, or a number of LoDs (at least 1) spread evenly from 0 to the
+    /// last; a number above the model's LoD count checks them all.
+    #[arg(long, default_value = "all", allow_negative_numbers = true)]
+    lods: String,
+    /// Print JSON instead of a sentence.
+    #[arg(long)]
+    json: bool,
+}
+
+fn verify(args: &VerifyArgs) -> Result<bool> {
+    let (name, model) = args.source.model()?;
+    let n = match args.lods.as_str() {
+        "all" => None,
+        text => {
+            let n: u128 = text.trim().parse().map_err(|_| {
+                anyhow::anyhow!("--lods takes `all` or a whole number of at least 1, not `{text}`")
+            })?;
+            if n == 0 {
+                bail!("--lods 0 checks nothing: give `all` or at least 1");
+            }
+            // More than the model has is all of them.
+            let all = model.max_lod() as u128 + 1;
+            (n < all).then_some(n as usize)
+        }
+    };
+    let lods = mts::model::spread_lods(model.max_lod(), n);
+    let t = Instant::now();
+    let report = mts::model::verify(&model, &model.mesh(), &lods);
+    let secs = t.elapsed().as_secs_f64();
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "lods_checked": report.lods_checked,
+                "mismatches": report.mismatches,
+                "first_mismatch": report.first_mismatch.as_ref().map(|(l, what)| json!({"lod": l, "what": what})),
+                "seconds": secs,
+            })
+        );
+    } else {
+        println!(
+            "{name}: {} LoDs checked against the replay oracle and from-scratch extraction in {secs:.2} s, {} mismatches",
+            report.lods_checked, report.mismatches
+        );
+        if let Some((lod, what)) = &report.first_mismatch {
+            println!("  first at LoD {lod}: {what}");
+        }
+    }
+    Ok(report.mismatches == 0)
+}
+
+fn info(args: &InfoArgs) -> Result<()> {
+    use mts::{Extractor, MtsModel};
+    let t0 = Instant::now();
+    let model = MtsModel::load(&args.model)?;
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let file_bytes = std::fs::metadata(&args.model)
+        .with_context(|| format!("cannot read {}", args.model.display()))?
+        .len();
+    let st = model.stats();
+    let mesh = model.mesh();
+    let mut ex = Extractor::new(&model);
+    let mut levels = Vec::new();
+    for ratio in [1.0, 0.5, 0.25, 0.1, 0.05, 0.01] {
+        let lod = model.lod_for_ratio(ratio);
+        ex.set_lod(lod);
+        let triangles = model.triangle_count(lod);
+        let fresh = stripify(
+            &model.collapses().mesh_at(&mesh, lod),
+            &StripifyOptions::default(),
+        );
+        let ours = ex.indices_sent() as f64 / triangles.max(1) as f64;
+        let theirs = fresh.restart_index_count() as f64 / triangles.max(1) as f64;
+        levels.push(json!({
+            "ratio": ratio,
+            "lod": lod,
+            "triangles": triangles,
+            "indices": ex.indices_sent(),
+            "indices_per_triangle": ours,
+            "restripified_indices_per_triangle": theirs,
+            "quality_ratio": ours / theirs,
+        }));
+    }
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "file": args.model.display().to_string(),
+                "file_bytes": file_bytes,
+                "raw_bytes": model.raw_bytes(),
+                "load_ms": load_ms,
+                "vertices": model.positions().len(),
+                "triangles": model.triangle_count(0),
+                "max_lod": model.max_lod(),
+                "bands": model.band_count(),
+                "strips": st.strips,
+                "nodes": st.nodes,
+                "arcs": st.arcs,
+                "memory_bytes": st.memory_bytes,
+                "levels": levels,
+            })
+        );
+    } else {
+        println!(
+            "{}: {} bytes ({:.2} x raw), loaded and built in {load_ms:.1} ms",
+            args.model.display(),
+            file_bytes,
+            file_bytes as f64 / model.raw_bytes() as f64
+        );
+        println!("  {} vertices, {} triangles, {} LoDs, {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
+            model.positions().len(), model.triangle_count(0), model.max_lod() + 1, model.band_count(), st.strips, st.nodes, st.arcs, st.memory_bytes as f64 / 1e6);
+        println!(
+            "  {:>6} {:>7} {:>9} {:>9} {:>11} {:>7}",
+            "share", "LoD", "triangles", "idx/tri", "restripify", "ratio"
+        );
+        for l in &levels {
+            println!(
+                "  {:>5.0}% {:>7} {:>9} {:>9.3} {:>11.3} {:>7.3}",
+                l["ratio"].as_f64().unwrap_or(0.0) * 100.0,
+                l["lod"].as_u64().unwrap_or(0),
+                l["triangles"].as_u64().unwrap_or(0),
+                l["indices_per_triangle"].as_f64().unwrap_or(0.0),
+                l["restripified_indices_per_triangle"]
+                    .as_f64()
+                    .unwrap_or(0.0),
+                l["quality_ratio"].as_f64().unwrap_or(0.0),
+            );
+        }
+    }
+    Ok(())
+}
+
+fn main() -> std::process::ExitCode {
+    // Mesa's implicit Vulkan layer VK_LAYER_MESA_device_select connects to
+    // Wayland to rank GPUs by the display they drive, and without
+    // XDG_RUNTIME_DIR (no Wayland session: a headless run) libwayland prints
+    // "error: XDG_RUNTIME_DIR is invalid or not set" twice, as if it were
+    // ours. With no session there is no display to rank by: the layer is
+    // switched off by its documented variable, unless the user set it.
+    // Set before any thread starts.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none()
+        && std::env::var_os("NODEVICE_SELECT").is_none()
+    {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
+    let cli = Cli::parse();
+    match run(&cli) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            // One line: the context, then each cause not already said.
+            let mut line = e.to_string();
+            for cause in e.chain().skip(1) {
+                let text = cause.to_string();
+                if !line.contains(&text) {
+                    line = format!("{line}: {text}");
+                }
+            }
+            eprintln!("error: {line}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn extract_baseline(args: &ExtractArgs) -> Result<()> {
+    let (name, model) = args.source.model()?;
+    let mesh = model.mesh();
+    let mut source = make_source(args.method, &model, &mesh)?;
+    let lod = args
+        .level
+        .resolve(source.as_ref())?
+        .context("give --lod, --triangles or --ratio")?;
+    // Each timed change starts from a fresh source (no coherence).
+    let mut times = Vec::with_capacity(args.repeat.max(1));
+    for _ in 0..args.repeat.max(1) {
+        source = make_source(args.method, &model, &mesh)?;
+        let t = Instant::now();
+        source.set_lod(lod);
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    times.sort_by(f64::total_cmp);
+    let us = times[times.len() / 2];
+    let triangles = source.triangles();
+    if let Some(out) = &args.output {
+        let m = Mesh {
+            positions: mesh.positions.clone(),
+            triangles: triangles.clone(),
+        };
+        mts::mesh::io::save_obj(&m, out)?;
+    }
+    let method = source.name();
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "method": method,
+                "lod": lod,
+                "max_lod": source.max_lod(),
+                "triangles": triangles.len(),
+                "indices": source.indices().len(),
+                "indices_per_triangle": source.indices().len() as f64 / triangles.len().max(1) as f64,
+                "us": us,
+            })
+        );
+    } else {
+        println!(
+            "{name}: {method} LoD {lod} of {}: {} triangles, {} indices sent, set in {us:.1} us (median of {} from a fresh source)",
+            source.max_lod(),
+            triangles.len(),
+            source.indices().len(),
+            times.len()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+struct EncodeArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// The stream file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Print JSON instead of a sentence.
+    #[arg(long)]
+    json: bool,
+}
+
+fn encode(args: &EncodeArgs) -> Result<()> {
+    let (name, mesh, _) = args.source.load()?;
+    let t = Instant::now();
+    let tree = mts::baselines::ClusterTree::new(&mesh)?;
+    let bytes = tree.to_stream();
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    std::fs::write(&args.output, &bytes)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    let raw = mesh.raw_bytes_u16();
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": name,
+                "vertices": mesh.vertex_count(),
+                "triangles": mesh.triangle_count(),
+                "bytes": bytes.len(),
+                "raw_bytes_u16": raw,
+                "ratio": bytes.len() as f64 / raw as f64,
+                "ms": ms,
+            })
+        );
+    } else {
+        println!(
+            "{name}: {} vertices, {} triangles -> {} bytes = {:.1}% of raw ({raw} bytes: 12 per vertex + 6 per triangle), {ms:.0} ms -> {}",
+            mesh.vertex_count(),
+            mesh.triangle_count(),
+            bytes.len(),
+            100.0 * bytes.len() as f64 / raw as f64,
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+struct DecodeArgs {
+    /// The stream file.
+    stream: PathBuf,
+    /// Decode only the first N bytes (the packets they hold completely).
+    #[arg(allow_negative_numbers = true, long)]
+    bytes: Option<usize>,
+    /// Write the decoded mesh as OBJ.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Print JSON instead of a sentence.
+    #[arg(long)]
+    json: bool,
+}
+
+fn decode(args: &DecodeArgs) -> Result<()> {
+    use mts::baselines::cluster::stream;
+    let all = mts::mesh::io::read_file(&args.stream)?;
+    let file = args.stream.display().to_string();
+    let t = Instant::now();
+    // A prefix shorter than the file is decoded as far as it goes; the
+    // whole file is decoded strictly (checksum and all) however it was asked.
+    let d = match args.bytes {
+        Some(n) if n < all.len() => stream::decode_prefix(&all[..n], &file)?,
+        _ => stream::decode(&all, &file)?,
+    };
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    let mesh = d.mesh();
+    mesh.validate()?;
+    if let Some(out) = &args.output {
+        mts::mesh::io::save_obj(&mesh, out)?;
+    }
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "input": file,
+                "bytes_read": args.bytes.unwrap_or(all.len()).min(all.len()),
+                "bytes_used": d.bytes_used,
+                "vertices": d.positions.len(),
+                "triangles": d.triangles.len(),
+                "total_vertices": d.total_vertices,
+                "total_triangles": d.total_triangles,
+                "complete": d.is_complete(),
+                "ms": ms,
+            })
+        );
+    } else {
+        println!(
+            "{file}: {} of {} vertices and {} of {} triangles from {} bytes ({}), {ms:.1} ms",
+            d.positions.len(),
+            d.total_vertices,
+            d.triangles.len(),
+            d.total_triangles,
+            d.bytes_used,
+            if d.is_complete() {
+                "complete"
+            } else {
+                "partial"
+            }
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+struct CompareArgs {
+    #[command(flatten)]
+    source: MeshSource,
+    /// Requests in each sequence (linear, exponential, random; 1 to 10
+    /// million).
+    #[arg(long, default_value_t = 100, value_parser = count_in::<1, MAX_REQUESTS>, allow_negative_numbers = true)]
+    requests: usize,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Every method (MTS and the baselines) over the same mesh and contraction
+/// sequence, measured in one run: build milliseconds (MTS: `mts_ms`, the
+/// whole pipeline; the baselines: their own construction from the mesh and
+/// MTS's sequence), bytes in memory and on disk, and microseconds per LoD
+/// change over the Table 2 sequences of `requests` requests each.
+fn measure_methods(
+    model: &mts::MtsModel,
+    mesh: &Mesh,
+    mts_ms: f64,
+    requests: usize,
+) -> Result<Vec<serde_json::Value>> {
+    use mts::model::sequence;
+    let raw = mesh.raw_bytes_u16();
+    let mut rows = Vec::new();
+    for method in Method::ALL {
+        if method == Method::Discrete {
+            if let Some(why) = peers::meshopt::refusal(mesh) {
+                rows.push(json!({"method": "discrete", "skipped": why}));
+                continue;
+            }
+        }
+        let t = Instant::now();
+        let mut source = make_source(method, model, mesh)?;
+        // The baselines start from the contraction sequence MTS recorded;
+        // its time is MTS's simplify stage, counted in MTS's build.
+        let build_ms =
+            t.elapsed().as_secs_f64() * 1e3 + if method == Method::Mts { mts_ms } else { 0.0 };
+        let max_lod = source.max_lod();
+        let counts: Vec<u32> = (0..=max_lod)
+            .map(|l| source.triangle_count(l) as u32)
+            .collect();
+        let sequences = [
+            ("linear", sequence::linear(max_lod, requests)),
+            ("exponential", sequence::exponential(&counts, requests)),
+            ("random", sequence::random(max_lod, requests, 1)),
+        ];
+        let mut us = serde_json::Map::new();
+        for (label, lods) in &sequences {
+            source.set_lod(max_lod);
+            let t = Instant::now();
+            for &l in lods {
+                source.set_lod(l);
+            }
+            let per = t.elapsed().as_secs_f64() * 1e6 / lods.len().max(1) as f64;
+            us.insert((*label).to_string(), json!(per));
+        }
+        let file = source.file_bytes();
+        rows.push(json!({
+            "method": source.name(),
+            "build_ms": build_ms,
+            "memory_bytes": source.memory_bytes(),
+            "file_bytes": file,
+            "file_ratio_to_raw_u16": file as f64 / raw as f64,
+            "us_per_change": us,
+        }));
+    }
+    Ok(rows)
+}
+
+fn compare(args: &CompareArgs) -> Result<()> {
+    let (name, mesh, _) = args.source.load()?;
+    let t = Instant::now();
+    let (model, _, _) = build_with_bar(&mesh, &Default::default());
+    let mts_ms = t.elapsed().as_secs_f64() * 1e3;
+    let raw = mesh.raw_bytes_u16();
+    let rows = measure_methods(&model, &mesh, mts_ms, args.requests)?;
+    let mesh_info = json!({
+        "input": name,
+        "vertices": mesh.vertex_count(),
+        "triangles": mesh.triangle_count(),
+        "raw_bytes_u16": raw,
+        "requests": args.requests,
+    });
+    if args.json {
+        println!("{}", json!({"mesh": mesh_info, "methods": rows}));
+        return Ok(());
+    }
+    println!(
+        "{name}: {} vertices, {} triangles, raw {raw} bytes (12 per vertex + 6 per triangle); {} requests per sequence",
+        mesh.vertex_count(),
+        mesh.triangle_count(),
+        args.requests
+    );
+    println!(
+        "{:<12}{:>10}{:>12}{:>12}{:>8}{:>10}{:>10}{:>10}",
+        "method", "build ms", "memory B", "file B", "/raw", "us lin", "us exp", "us rand"
+    );
+    for r in &rows {
+        if let Some(why) = r["skipped"].as_str() {
+            println!("{:<12}{why}", r["method"].as_str().unwrap_or(""));
+            continue;
+        }
+        let f = |v: &serde_json::Value| v.as_f64().unwrap_or(0.0);
+        println!(
+            "{:<12}{:>10.1}{:>12}{:>12}{:>8.3}{:>10.1}{:>10.1}{:>10.1}",
+            r["method"].as_str().unwrap_or(""),
+            f(&r["build_ms"]),
+            r["memory_bytes"].as_u64().unwrap_or(0),
+            r["file_bytes"].as_u64().unwrap_or(0),
+            f(&r["file_ratio_to_raw_u16"]),
+            f(&r["us_per_change"]["linear"]),
+            f(&r["us_per_change"]["exponential"]),
+            f(&r["us_per_change"]["random"]),
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,475 @@
+//! `mts view`: a window (winit) with an orbit camera around one model, or
+//! an [`InstancedScene`], drawn by the same renderer as everything else.
+//!
+//! Controls: drag with the left button (or the arrow keys) to orbit, `W`/`S`
+//! to move closer or farther; the mouse wheel, `Up`/`Down` or `+`/`-`
+//! change the LoD continuously (10% of the triangles per step); `A` toggles
+//! the automatic mode, which picks the LoD from the projected size (see
+//! [`mts_render::scene::PIXELS_PER_TRIANGLE`]); `Escape` quits. The
+//! title shows triangles, indices sent, the last extraction's microseconds
+//! and frames per second.
+
+use glam::Vec3;
+use mts::model::Extractor;
+use mts::{Error, MtsModel, Result};
+use mts_render::camera::Camera;
+use mts_render::gpu::AdapterReport;
+use mts_render::scene::{InstancedScene, PIXELS_PER_TRIANGLE};
+use mts_render::strip_renderer::{RendererConfig, StripRenderer};
+use std::sync::Arc;
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
+
+/// Depth format of the viewer's window.
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// LoD change per wheel notch or key press: this factor of the triangles.
+const LOD_STEP: f64 = 1.1;
+/// Seconds between title updates.
+const TITLE_PERIOD: f64 = 0.5;
+
+/// What the viewer shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ViewerContent {
+    /// The model alone.
+    Model,
+    /// This many instances of it on a ground plane.
+    Scene(usize),
+}
+
+/// What a viewer session did, for a closing line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewerReport {
+    /// The adapter that drew.
+    pub adapter: AdapterReport,
+    /// Frames presented.
+    pub frames: u64,
+    /// Seconds from the first frame to the last.
+    pub seconds: f64,
+    /// The last window title (triangles, indices, extraction, fps).
+    pub last_status: String,
+}
+
+/// Opens a window on `model` and runs until it is closed, or until
+/// `max_frames` frames were presented when given (for scripted runs).
+///
+/// # Errors
+/// [`Error::Gpu`] when no window, surface, adapter or device can be
+/// created (no display, or no adapter that can present to it), and the
+/// errors of [`StripRenderer::for_model`] and [`InstancedScene::new`].
+pub fn run(
+    model: &MtsModel,
+    content: ViewerContent,
+    title: &str,
+    max_frames: Option<u64>,
+) -> Result<ViewerReport> {
+    let event_loop = EventLoop::new().map_err(|e| Error::Gpu(format!("no event loop: {e}")))?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        model,
+        content,
+        title: title.to_owned(),
+        max_frames,
+        state: None,
+        error: None,
+    };
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| Error::Gpu(format!("event loop: {e}")))?;
+    if let Some(e) = app.error {
+        return Err(e);
+    }
+    let state = app
+        .state
+        .ok_or_else(|| Error::Gpu("the window never opened".into()))?;
+    Ok(ViewerReport {
+        adapter: state.report,
+        frames: state.total_frames,
+        seconds: state.started.elapsed().as_secs_f64(),
+        last_status: state.status,
+    })
+}
+
+struct App<'m> {
+    model: &'m MtsModel,
+    content: ViewerContent,
+    title: String,
+    max_frames: Option<u64>,
+    state: Option<State<'m>>,
+    error: Option<Error>,
+}
+
+/// Everything that exists once the window does.
+struct State<'m> {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    config: wgpu::SurfaceConfiguration,
+    depth: wgpu::TextureView,
+    report: AdapterReport,
+    drawn: Drawn<'m>,
+    orbit: Orbit,
+    /// Share of the triangles asked for in manual mode (0..1].
+    ratio: f64,
+    auto: bool,
+    dragging: bool,
+    last_cursor: Option<(f64, f64)>,
+    extract_us: f64,
+    /// Frames since the last title update, and that update's time.
+    frames: u32,
+    since: Instant,
+    total_frames: u64,
+    started: Instant,
+    /// What the title shows (kept here: not every platform reads it back).
+    status: String,
+}
+
+// One value per window, never moved around: the size difference is moot.
+#[allow(clippy::large_enum_variant)]
+enum Drawn<'m> {
+    Model {
+        renderer: StripRenderer,
+        extractor: Extractor<'m>,
+    },
+    Scene(InstancedScene<'m>),
+}
+
+/// Orbit camera around `centre`: yaw and pitch in radians, distance in
+/// bounding-sphere radii.
+#[derive(Debug, Clone, Copy)]
+struct Orbit {
+    centre: Vec3,
+    radius: f32,
+    yaw: f32,
+    pitch: f32,
+    distance: f32,
+}
+
+impl Orbit {
+    fn eye(&self) -> Vec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        self.centre + Vec3::new(cp * sy, sp, cp * cy) * self.distance * self.radius
+    }
+
+    fn camera(&self, aspect: f32) -> Camera {
+        let d = self.distance * self.radius;
+        Camera::looking(
+            self.eye(),
+            self.centre,
+            aspect,
+            (d - 1.5 * self.radius).max(d * 1e-3),
+            d + 1.5 * self.radius,
+        )
+    }
+}
+
+impl ApplicationHandler for App<'_> {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.state.is_some() {
+            return;
+        }
+        match State::new(event_loop, self.model, self.content, &self.title) {
+            Ok(state) => self.state = Some(state),
+            Err(e) => {
+                self.error = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some(state) = &mut self.state else {
+            return;
+        };
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => state.resize(size.width, size.height),
+            WindowEvent::MouseWheel { delta, .. } => {
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => f64::from(y),
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                state.auto = false;
+                state.step_lod(notches);
+            }
+            WindowEvent::MouseInput {
+                state: pressed,
+                button: MouseButton::Left,
+                ..
+            } => {
+                state.dragging = pressed == ElementState::Pressed;
+                state.last_cursor = None;
+            }
+            WindowEvent::CursorMoved { position, .. } if state.dragging => {
+                if let Some((x, y)) = state.last_cursor {
+                    state.orbit.yaw -= ((position.x - x) * 0.01) as f32;
+                    state.orbit.pitch =
+                        (state.orbit.pitch + ((position.y - y) * 0.01) as f32).clamp(-1.5, 1.5);
+                }
+                state.last_cursor = Some((position.x, position.y));
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                match event.logical_key.as_ref() {
+                    Key::Named(NamedKey::Escape) => event_loop.exit(),
+                    Key::Named(NamedKey::ArrowUp) | Key::Character("+") => {
+                        state.auto = false;
+                        state.step_lod(1.0);
+                    }
+                    Key::Named(NamedKey::ArrowDown) | Key::Character("-") => {
+                        state.auto = false;
+                        state.step_lod(-1.0);
+                    }
+                    Key::Named(NamedKey::ArrowLeft) => state.orbit.yaw += 0.1,
+                    Key::Named(NamedKey::ArrowRight) => state.orbit.yaw -= 0.1,
+                    Key::Character("a" | "A") => state.auto = !state.auto,
+                    Key::Character("w" | "W") => {
+                        state.orbit.distance = (state.orbit.distance / 1.1).max(1.05);
+                    }
+                    Key::Character("s" | "S") => state.orbit.distance *= 1.1,
+                    _ => {}
+                }
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = state.frame() {
+                    self.error = Some(e);
+                    event_loop.exit();
+                }
+                if self.max_frames.is_some_and(|m| state.total_frames >= m) {
+                    event_loop.exit();
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        if let Some(state) = &self.state {
+            state.window.request_redraw();
+        }
+    }
+}
+
+impl<'m> State<'m> {
+    fn new(
+        event_loop: &ActiveEventLoop,
+        model: &'m MtsModel,
+        content: ViewerContent,
+        title: &str,
+    ) -> Result<State<'m>> {
+        let gpu = |what: &str, e: &dyn std::fmt::Display| Error::Gpu(format!("{what}: {e}"));
+        let window = Arc::new(
+            event_loop
+                .create_window(Window::default_attributes().with_title(title))
+                .map_err(|e| gpu("cannot open a window", &e))?,
+        );
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+                Box::new(event_loop.owned_display_handle()),
+            ));
+        let surface = instance
+            .create_surface(window.clone())
+            .map_err(|e| gpu("cannot create a surface", &e))?;
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            compatible_surface: Some(&surface),
+            ..wgpu::RequestAdapterOptions::default()
+        }))
+        .map_err(|e| gpu("no adapter for this window", &e))?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("mts viewer"),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            ..wgpu::DeviceDescriptor::default()
+        }))
+        .map_err(|e| gpu("cannot create a device", &e))?;
+        let size = window.inner_size();
+        let mut config = surface
+            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
+            .ok_or_else(|| Error::Gpu("the surface does not suit the adapter".into()))?;
+        if let Some(&srgb) = surface
+            .get_capabilities(&adapter)
+            .formats
+            .iter()
+            .find(|f| f.is_srgb())
+        {
+            config.format = srgb;
+        }
+        surface.configure(&device, &config);
+        let report = AdapterReport::from_info(&adapter.get_info());
+        let renderer_config = RendererConfig {
+            color_format: config.format,
+            depth_format: Some(DEPTH_FORMAT),
+            strip_mode: report.strip_mode,
+        };
+        let (drawn, centre, radius) = match content {
+            ViewerContent::Model => {
+                let renderer = StripRenderer::for_model(&device, &queue, &renderer_config, model)?;
+                let (lo, hi) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
+                let drawn = Drawn::Model {
+                    renderer,
+                    extractor: Extractor::new(model),
+                };
+                (drawn, (lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-6))
+            }
+            ViewerContent::Scene(n) => {
+                // Stitched on backends that ignore primitive restart.
+                let scene = InstancedScene::new(&device, &queue, &renderer_config, model, n)?;
+                let (lo, hi) = scene.instances().iter().fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), i| (lo.min(i.centre), hi.max(i.centre)),
+                );
+                let radius = ((hi - lo).length() * 0.5).max(1e-6);
+                (Drawn::Scene(scene), (lo + hi) * 0.5, radius)
+            }
+        };
+        let depth = depth_view(&device, config.width, config.height);
+        Ok(State {
+            window,
+            surface,
+            device,
+            queue,
+            config,
+            depth,
+            report,
+            drawn,
+            orbit: Orbit {
+                centre,
+                radius,
+                yaw: 0.55,
+                pitch: 0.35,
+                distance: 3.0,
+            },
+            ratio: 1.0,
+            auto: matches!(content, ViewerContent::Scene(_)),
+            dragging: false,
+            last_cursor: None,
+            extract_us: 0.0,
+            frames: 0,
+            since: Instant::now(),
+            total_frames: 0,
+            started: Instant::now(),
+            status: String::new(),
+        })
+    }
+
+    fn resize(&mut self, width: u32, height: u32) {
+        if width == 0 || height == 0 {
+            return;
+        }
+        self.config.width = width;
+        self.config.height = height;
+        self.surface.configure(&self.device, &self.config);
+        self.depth = depth_view(&self.device, width, height);
+    }
+
+    /// Changes the manual LoD by `notches` steps (positive: finer).
+    fn step_lod(&mut self, notches: f64) {
+        self.ratio = (self.ratio * LOD_STEP.powf(notches)).clamp(1e-4, 1.0);
+    }
+
+    fn frame(&mut self) -> Result<()> {
+        let (w, h) = (self.config.width, self.config.height);
+        let camera = self.orbit.camera(w as f32 / h as f32);
+        let t = Instant::now();
+        let (triangles, indices) = match &mut self.drawn {
+            Drawn::Model {
+                renderer,
+                extractor,
+            } => {
+                let model = extractor.model();
+                let lod = if self.auto {
+                    let row_y = camera.view_proj.row(1).truncate().length();
+                    let d = self.orbit.distance * self.orbit.radius;
+                    let r_px = self.orbit.radius * row_y * 0.5 * h as f32 / d;
+                    let budget = std::f32::consts::PI * r_px * r_px / PIXELS_PER_TRIANGLE;
+                    model.lod_for_triangles(budget.max(1.0) as usize)
+                } else {
+                    model.lod_for_ratio(self.ratio)
+                };
+                if extractor.lod() != Some(lod) {
+                    extractor.set_lod(lod);
+                    renderer.update_strips(&self.device, &self.queue, extractor)?;
+                    self.extract_us = t.elapsed().as_secs_f64() * 1e6;
+                }
+                renderer.set_camera(&self.queue, &camera);
+                (model.triangle_count(lod), extractor.indices_sent())
+            }
+            Drawn::Scene(scene) => {
+                let stats = scene.update(&self.queue, &camera, h as f32);
+                if stats.lod_changes > 0 {
+                    self.extract_us = t.elapsed().as_secs_f64() * 1e6;
+                }
+                (stats.triangles, stats.indices_sent)
+            }
+        };
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.device, &self.config);
+                return Ok(());
+            }
+            _ => return Ok(()),
+        };
+        let view = frame
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        {
+            let mut pass = mts_render::headless::begin_cleared_pass(
+                &mut encoder,
+                "mts viewer",
+                &view,
+                &self.depth,
+            );
+            match &self.drawn {
+                Drawn::Model { renderer, .. } => renderer.draw(&mut pass),
+                Drawn::Scene(scene) => scene.draw(&mut pass),
+            }
+        }
+        self.queue.submit([encoder.finish()]);
+        self.queue.present(frame);
+        self.frames += 1;
+        self.total_frames += 1;
+        let elapsed = self.since.elapsed().as_secs_f64();
+        if elapsed >= TITLE_PERIOD {
+            let fps = f64::from(self.frames) / elapsed;
+            self.status = format!(
+                "mts view: {triangles} triangles{}, {indices} indices sent, extraction {:.0} us, \
+                 {fps:.0} fps ({}, {:?})",
+                if self.auto { " (auto)" } else { "" },
+                self.extract_us,
+                self.report.name,
+                self.report.backend
+            );
+            self.window.set_title(&self.status);
+            self.frames = 0;
+            self.since = Instant::now();
+        }
+        Ok(())
+    }
+}
+
+fn depth_view(device: &wgpu::Device, width: u32, height: u32) -> wgpu::TextureView {
+    device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("mts viewer depth"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor::default())
+}

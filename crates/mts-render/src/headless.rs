@@ -1,0 +1,327 @@
+//! Headless rendering: a colour and depth texture to draw into, a readback
+//! through a staging buffer (rows padded to wgpu's 256-byte copy
+//! alignment), and the RGBA8 image written as PNG.
+
+use mts::{Error, Result};
+use std::path::Path;
+
+/// Colour format of [`HeadlessTarget`] (8-bit sRGB, what a PNG holds).
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// Depth format of [`HeadlessTarget`].
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Clear colour of [`HeadlessTarget::render`] (a dark blue-grey; the
+/// background pixels of the PNG are `BACKGROUND_RGBA`).
+pub const BACKGROUND: wgpu::Color = wgpu::Color {
+    r: 0.02,
+    g: 0.025,
+    b: 0.035,
+    a: 1.0,
+};
+
+/// An RGBA8 image read back from the GPU, rows top to bottom, no padding.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `4 * width * height` bytes, sRGB-encoded RGBA.
+    pub rgba: Vec<u8>,
+}
+
+impl Image {
+    /// Pixels whose RGBA differs from the top-left pixel (the background
+    /// wherever the model does not reach the corner). Cost: O(pixels).
+    #[must_use]
+    pub fn foreground_pixels(&self) -> usize {
+        let Some(corner) = self.rgba.get(..4) else {
+            return 0;
+        };
+        self.rgba.chunks_exact(4).filter(|p| *p != corner).count()
+    }
+
+    /// Pixels that differ between `self` and `other` (every pixel when the
+    /// sizes differ). Cost: O(pixels).
+    #[must_use]
+    pub fn differing_pixels(&self, other: &Image) -> usize {
+        if (self.width, self.height) != (other.width, other.height) {
+            return (self.width * self.height).max(other.width * other.height) as usize;
+        }
+        self.rgba
+            .chunks_exact(4)
+            .zip(other.rgba.chunks_exact(4))
+            .filter(|(a, b)| a != b)
+            .count()
+    }
+
+    /// Writes the image as an 8-bit RGBA PNG.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be created or written.
+    pub fn save_png(&self, path: &Path) -> Result<()> {
+        let io = |source: std::io::Error| Error::Io {
+            file: path.to_owned(),
+            source,
+        };
+        let file = std::fs::File::create(path).map_err(io)?;
+        let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        let png_error = |e: png::EncodingError| io(std::io::Error::other(e));
+        let mut writer = encoder.write_header().map_err(png_error)?;
+        writer.write_image_data(&self.rgba).map_err(png_error)?;
+        writer.finish().map_err(png_error)
+    }
+}
+
+/// A colour texture ([`COLOR_FORMAT`]) and depth texture ([`DEPTH_FORMAT`])
+/// of one size, and the staging buffer to read the colour back.
+#[derive(Debug)]
+pub struct HeadlessTarget {
+    width: u32,
+    height: u32,
+    color: wgpu::Texture,
+    color_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    staging: wgpu::Buffer,
+    /// `4 * width` rounded up to `COPY_BYTES_PER_ROW_ALIGNMENT` (256).
+    padded_row: u32,
+}
+
+impl HeadlessTarget {
+    /// Textures and staging buffer for `width × height` pixels.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for a zero size or one above the device's
+    /// `max_texture_dimension_2d`.
+    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Result<HeadlessTarget> {
+        let max = device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(Error::InvalidArgument(format!(
+                "image size {width}x{height} outside 1..={max} per side"
+            )));
+        }
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let texture = |format, usage, label| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let color = texture(
+            COLOR_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            "mts colour",
+        );
+        let depth = texture(
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+            "mts depth",
+        );
+        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded_row = (4 * width).div_ceil(align) * align;
+        let readback = u64::from(padded_row) * u64::from(height);
+        let max_buffer = device.limits().max_buffer_size;
+        if readback > max_buffer {
+            return Err(Error::InvalidArgument(format!(
+                "image size {width}x{height} needs a {readback}-byte readback buffer, above the \
+                 device's max_buffer_size {max_buffer}"
+            )));
+        }
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("mts readback"),
+            size: readback,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        Ok(HeadlessTarget {
+            width,
+            height,
+            color_view: color.create_view(&wgpu::TextureViewDescriptor::default()),
+            depth_view: depth.create_view(&wgpu::TextureViewDescriptor::default()),
+            color,
+            staging,
+            padded_row,
+        })
+    }
+
+    /// Width and height in pixels.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Width / height, for [`crate::Camera::framing`].
+    #[must_use]
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// Clears to [`BACKGROUND`] (depth 1), lets `draw` record into the pass,
+    /// submits, and waits for the GPU. Cost: one submission and a wait.
+    ///
+    /// # Errors
+    /// [`Error::Gpu`] when waiting for the device fails.
+    pub fn render(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) -> Result<()> {
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("mts headless frame"),
+        });
+        self.encode_pass(&mut encoder, draw);
+        queue.submit([encoder.finish()]);
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu(format!("waiting for the frame: {e}")))?;
+        Ok(())
+    }
+
+    /// [`HeadlessTarget::render`], then copies the colour texture to the
+    /// staging buffer and reads it back without the row padding.
+    ///
+    /// # Errors
+    /// [`Error::Gpu`] when waiting or mapping fails.
+    ///
+    /// Cost: one submission, a copy of `padded_row × height` bytes, a wait.
+    pub fn render_image(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) -> Result<Image> {
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("mts headless frame"),
+        });
+        self.encode_pass(&mut encoder, draw);
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.color,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row),
+                    rows_per_image: Some(self.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
+        );
+        queue.submit([encoder.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        self.staging
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |r| {
+                // The receiver outlives the poll below; a send error cannot
+                // happen and would only mean nobody is waiting.
+                let _ = tx.send(r);
+            });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu(format!("waiting for the readback: {e}")))?;
+        rx.recv()
+            .map_err(|e| Error::Gpu(format!("readback callback lost: {e}")))?
+            .map_err(|e| Error::Gpu(format!("mapping the readback buffer: {e}")))?;
+        let row = 4 * self.width as usize;
+        let mut rgba = Vec::with_capacity(row * self.height as usize);
+        {
+            let view = self
+                .staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| Error::Gpu(format!("reading the readback buffer: {e}")))?;
+            for line in view.chunks_exact(self.padded_row as usize) {
+                rgba.extend_from_slice(&line[..row]);
+            }
+        }
+        self.staging.unmap();
+        Ok(Image {
+            width: self.width,
+            height: self.height,
+            rgba,
+        })
+    }
+
+    /// Records the cleared pass and `draw` into `encoder`.
+    fn encode_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) {
+        let mut pass = begin_cleared_pass(
+            encoder,
+            "mts headless pass",
+            &self.color_view,
+            &self.depth_view,
+        );
+        draw(&mut pass);
+    }
+}
+
+impl crate::RendererConfig {
+    /// The configuration that draws into a [`HeadlessTarget`] (its colour
+    /// and depth formats), sending strips by `strip_mode`.
+    #[must_use]
+    pub fn headless(strip_mode: crate::StripMode) -> crate::RendererConfig {
+        crate::RendererConfig {
+            color_format: COLOR_FORMAT,
+            depth_format: Some(DEPTH_FORMAT),
+            strip_mode,
+        }
+    }
+}
+
+/// Begins a pass that clears `color` to [`BACKGROUND`] and `depth` to 1
+/// (depth is not kept after the pass): what every headless frame and every
+/// viewer frame draws into.
+pub fn begin_cleared_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    color: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: color,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(BACKGROUND),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

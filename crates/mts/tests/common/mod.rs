@@ -1,0 +1,101 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use glam::Vec3;
+use mts::mesh::io::{load, LoadOptions};
+use mts::mesh::Mesh;
+use proptest::prelude::*;
+use std::path::Path;
+
+/// A random open surface: a height field over a grid with random holes,
+/// triangles flipped or duplicated, and a second flat component.
+pub fn random_surface() -> impl Strategy<Value = Mesh> {
+    (2u32..10, 2u32..10, prop::collection::vec(0u8..20, 400)).prop_map(|(w, h, dice)| {
+        let mut d = dice.iter().cycle();
+        let mut roll = || *d.next().unwrap();
+        let id = |x: u32, y: u32| y * (w + 1) + x;
+        let mut positions = Vec::new();
+        for y in 0..=h {
+            for x in 0..=w {
+                let z = f32::from(roll()) * 0.05;
+                positions.push(Vec3::new(x as f32, y as f32, z));
+            }
+        }
+        let mut triangles = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let (a, b, c, e) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
+                for t in [[a, b, c], [a, c, e]] {
+                    match roll() {
+                        0 => {}
+                        1 => triangles.push([t[0], t[2], t[1]]),
+                        2 => {
+                            triangles.push(t);
+                            triangles.push(t);
+                        }
+                        _ => triangles.push(t),
+                    }
+                }
+            }
+        }
+        let base = positions.len() as u32;
+        positions.extend([
+            Vec3::new(0.0, 0.0, 5.0),
+            Vec3::new(1.0, 0.0, 5.0),
+            Vec3::new(1.0, 1.0, 5.0),
+            Vec3::new(0.0, 1.0, 5.0),
+        ]);
+        triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+        let raw = mts::mesh::RawMesh {
+            positions,
+            triangles,
+            degenerate_in_source: 0,
+        };
+        mts::mesh::clean(raw, Default::default(), "random")
+            .unwrap()
+            .0
+    })
+}
+
+/// Whether `MTS_REQUIRE` (a comma-separated list, set by `.ci/run`) names
+/// `what`: then a missing resource fails the test instead of skipping it.
+pub fn required(what: &str) -> bool {
+    std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w.trim() == what))
+}
+
+/// `../shared/models`, or `None` (with a message saying the test is
+/// skipped) when it is absent; a failure instead when `MTS_REQUIRE` names
+/// `models`.
+pub fn models_dir() -> Option<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    assert!(
+        !required("models"),
+        "{} not found and MTS_REQUIRE names models",
+        dir.display()
+    );
+    eprintln!("skipped: {} not found", dir.display());
+    None
+}
+
+/// A model from `../shared/models`, or `None` (with a message saying the test
+/// is skipped) when the directory is absent (a failure when `MTS_REQUIRE`
+/// names `models`).
+pub fn model(name: &str) -> Option<Mesh> {
+    let path = models_dir()?.join(name);
+    if !path.exists() {
+        assert!(
+            !required("models"),
+            "{} not found and MTS_REQUIRE names models",
+            path.display()
+        );
+        eprintln!(
+            "skipped: {} not found (needs ../shared/models)",
+            path.display()
+        );
+        return None;
+    }
+    Some(load(&path, LoadOptions::default()).unwrap().0)
+}

@@ -1,0 +1,403 @@
+//! The MTS model against the replay oracle: every LoD of generated and
+//! random meshes, the positional rule recomputed naively, coherent against
+//! from-scratch extraction over several LoD sequences, dirty ranges, the
+//! `.mts` file (round trip and corrupt bytes), and real models.
+
+mod common;
+
+use common::{model, random_surface};
+use mts::mesh::generate::Generated;
+use mts::model::{format::seal, BuildOptions};
+use mts::simplify::{Placement, SimplifyOptions};
+use mts::strip::encode::RESTART_U32;
+use mts::strip::sorted_canonical;
+use mts::{stripify, Collapses, Extractor, Mesh, MtsModel, StripifyOptions};
+use proptest::prelude::*;
+use std::path::Path;
+
+fn single_band() -> BuildOptions {
+    BuildOptions {
+        band_slack: f64::INFINITY,
+        ..BuildOptions::default()
+    }
+}
+
+fn build(mesh: &Mesh, simplify: &SimplifyOptions, options: &BuildOptions) -> MtsModel {
+    let strips = stripify(mesh, &StripifyOptions::default());
+    let collapses = mts::simplify(mesh, simplify).collapses;
+    mts::model::build(mesh, &strips, &collapses, options)
+}
+
+/// The naive positional rule of `build.rs` on one run of representatives:
+/// contiguous between live windows `a < b` when `b - a - 3 <= 1 + (b odd)`,
+/// otherwise a restart and a start at `b` or (odd `b`) `b - 1`.
+fn rule(run: &[u32]) -> Vec<u32> {
+    let live: Vec<usize> = (0..run.len().saturating_sub(2))
+        .filter(|&i| !mts::mesh::is_degenerate([run[i], run[i + 1], run[i + 2]]))
+        .collect();
+    let mut out = Vec::new();
+    let mut prev: Option<usize> = None;
+    for &b in &live {
+        let odd = b % 2;
+        let start = match prev {
+            Some(a) if b as i64 - a as i64 - 3 <= 1 + odd as i64 => a + 3,
+            Some(_) => {
+                out.push(RESTART_U32);
+                b - odd
+            }
+            None => b - odd,
+        };
+        let start = prev.map_or(start, |a| start.max(a + 3));
+        out.extend((start..=b + 2).map(|p| run[p]));
+        prev = Some(b);
+    }
+    out
+}
+
+/// Every `step`-th LoD: the oracle's triangles, coherent output identical
+/// to from-scratch output, the compact count, and (single band) the naive
+/// rule strip by strip. Dirty ranges cover every changed index.
+fn check_lods(mesh: &Mesh, m: &MtsModel, step: usize) {
+    m.check().unwrap();
+    let collapses: &Collapses = m.collapses();
+    let mut coherent = Extractor::new(m);
+    let mut scratch = Extractor::new(m);
+    let mut before = coherent.buffer().to_vec();
+    let mut compact = Vec::new();
+    let mut lod = 0;
+    loop {
+        coherent.set_lod(lod);
+        scratch.set_lod_from_scratch(lod);
+        assert_eq!(
+            coherent.buffer(),
+            scratch.buffer(),
+            "LoD {lod}: coherent differs"
+        );
+        for (i, (a, b)) in before.iter().zip(coherent.buffer()).enumerate() {
+            if a != b {
+                assert!(
+                    coherent.dirty_ranges().iter().any(|r| r.contains(&i)),
+                    "LoD {lod}: index {i} changed outside the dirty ranges"
+                );
+            }
+        }
+        before.copy_from_slice(coherent.buffer());
+        let want = sorted_canonical(&collapses.triangles_at(mesh, lod));
+        assert_eq!(sorted_canonical(&scratch.triangles()), want, "LoD {lod}");
+        assert_eq!(want.len(), m.triangle_count(lod));
+        coherent.write_compact(&mut compact);
+        assert_eq!(compact.len(), coherent.indices_sent());
+        let active = coherent.active_range();
+        assert!(coherent.buffer()[..active.start]
+            .iter()
+            .all(|&i| i == RESTART_U32));
+        assert!(coherent.buffer()[active.end..]
+            .iter()
+            .all(|&i| i == RESTART_U32));
+        if m.band_count() == 1 {
+            let rep = collapses.representatives(lod);
+            for (s, run) in m.base_strips().runs().enumerate() {
+                let r: Vec<u32> = run.iter().map(|&v| rep[v as usize]).collect();
+                assert_eq!(coherent.strip(s), &rule(&r)[..], "LoD {lod} strip {s}");
+            }
+        }
+        if lod == collapses.max_lod() {
+            break;
+        }
+        lod = (lod + step).min(collapses.max_lod());
+    }
+}
+
+#[test]
+fn torus_every_lod_one_band_and_banded() {
+    let mesh: Mesh = "torus:2k".parse::<Generated>().unwrap().build();
+    let one = build(&mesh, &SimplifyOptions::default(), &single_band());
+    assert_eq!(one.band_count(), 1);
+    check_lods(&mesh, &one, 1);
+    let banded = build(&mesh, &SimplifyOptions::default(), &BuildOptions::default());
+    assert!(banded.band_count() > 1, "a 2K torus degrades past 10%");
+    check_lods(&mesh, &banded, 1);
+}
+
+#[test]
+fn optimal_placement_every_lod() {
+    let mesh: Mesh = "icosphere:1k".parse::<Generated>().unwrap().build();
+    let options = SimplifyOptions {
+        placement: Placement::Optimal,
+        ..SimplifyOptions::default()
+    };
+    check_lods(&mesh, &build(&mesh, &options, &single_band()), 1);
+    check_lods(&mesh, &build(&mesh, &options, &BuildOptions::default()), 1);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn every_lod_of_random_surfaces(m in random_surface()) {
+        check_lods(&m, &build(&m, &SimplifyOptions::default(), &single_band()), 1);
+        check_lods(&m, &build(&m, &SimplifyOptions::default(), &BuildOptions::default()), 1);
+    }
+}
+
+/// LoD sequences of the paper's Table 2 and a return trip.
+fn sequences(max_lod: usize) -> Vec<(&'static str, Vec<usize>)> {
+    let linear: Vec<usize> = (0..=max_lod).collect();
+    let down: Vec<usize> = (0..=max_lod).rev().collect();
+    let mut exponential = vec![0];
+    let mut k = 1;
+    while k <= max_lod {
+        exponential.push(k);
+        k *= 2;
+    }
+    exponential.extend(exponential.clone().into_iter().rev());
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    let random = (0..300)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % (max_lod as u64 + 1)) as usize
+        })
+        .collect();
+    vec![
+        ("linear", linear),
+        ("down", down),
+        ("exponential", exponential),
+        ("random", random),
+    ]
+}
+
+#[test]
+fn coherent_equals_scratch_on_every_sequence() {
+    let mesh: Mesh = "icosphere:20k".parse::<Generated>().unwrap().build();
+    let m = build(&mesh, &SimplifyOptions::default(), &BuildOptions::default());
+    for (name, seq) in sequences(m.max_lod()) {
+        let mut coherent = Extractor::new(&m);
+        let mut scratch = Extractor::new(&m);
+        let mut walked = 0;
+        for &lod in &seq {
+            walked += coherent.set_lod(lod).strips_walked;
+            scratch.set_lod_from_scratch(lod);
+            assert_eq!(coherent.buffer(), scratch.buffer(), "{name}: LoD {lod}");
+        }
+        if name == "linear" {
+            // Coherence re-walks a small share of the strips per step.
+            let strips = m.stats().strips;
+            assert!(
+                walked < strips * seq.len() / 20,
+                "{walked} walks over {} steps",
+                seq.len()
+            );
+        }
+    }
+}
+
+#[test]
+fn file_round_trip_builds_the_same_model() {
+    let mesh: Mesh = "icosphere:5k".parse::<Generated>().unwrap().build();
+    for options in [BuildOptions::default(), single_band()] {
+        let m = build(&mesh, &SimplifyOptions::default(), &options);
+        let bytes = m.to_bytes();
+        let back = MtsModel::from_bytes(&bytes, Path::new("mem.mts")).unwrap();
+        assert_eq!(back, m);
+        assert!(
+            bytes.len() < m.raw_bytes(),
+            "{} bytes, raw {}",
+            bytes.len(),
+            m.raw_bytes()
+        );
+    }
+    let opt = SimplifyOptions {
+        placement: Placement::Optimal,
+        ..SimplifyOptions::default()
+    };
+    let m = build(&mesh, &opt, &BuildOptions::default());
+    let back = MtsModel::from_bytes(&m.to_bytes(), Path::new("mem.mts")).unwrap();
+    assert_eq!(back, m);
+}
+
+fn small_file() -> Vec<u8> {
+    let mesh: Mesh = "torus:300".parse::<Generated>().unwrap().build();
+    build(&mesh, &SimplifyOptions::default(), &BuildOptions::default()).to_bytes()
+}
+
+fn load_err(bytes: &[u8]) -> String {
+    MtsModel::from_bytes(bytes, Path::new("bad.mts"))
+        .expect_err("corrupt file accepted")
+        .to_string()
+}
+
+/// Offset of a section's payload.
+fn section(bytes: &[u8], tag: &[u8; 4]) -> usize {
+    let mut at = 32;
+    loop {
+        let len = u64::from_le_bytes(bytes[at + 4..at + 12].try_into().unwrap()) as usize;
+        if &bytes[at..at + 4] == tag {
+            return at + 12;
+        }
+        at += 12 + len;
+    }
+}
+
+#[test]
+fn corrupt_files_get_errors_naming_the_place() {
+    let good = small_file();
+    let e = load_err(&good[..good.len() - 7]);
+    assert!(e.contains("bad.mts") && e.contains("truncated"), "{e}");
+    let mut b = good.clone();
+    b[0] = b'X';
+    assert!(load_err(&b).contains("not an .mts file"));
+    let mut b = good.clone();
+    b[8] = 9;
+    assert!(load_err(&b).contains("version 9"));
+    let mut b = good.clone();
+    let n = b.len();
+    b[n - 1] ^= 0x55;
+    assert!(load_err(&b).contains("checksum"));
+    // Past the checksum: absurd counts, bad indices, NaN, bad steps.
+    let meta = section(&good, b"META");
+    let mut b = good.clone();
+    b[meta..meta + 3].copy_from_slice(&[0xff, 0xff, 0x7f]); // 2,097,151 vertices
+    seal(&mut b);
+    let e = load_err(&b);
+    assert!(
+        e.contains("META") && e.contains("vertex count 2097151 exceeds"),
+        "{e}"
+    );
+    let posi = section(&good, b"POSI");
+    let mut b = good.clone();
+    b[posi..posi + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    seal(&mut b);
+    let e = load_err(&b);
+    assert!(
+        e.contains("POSI") && e.contains("vertex 0 is not finite"),
+        "{e}"
+    );
+    let step = section(&good, b"STEP");
+    let mut b = good.clone();
+    b[step] = 0x7e; // removed vertex beyond the vertex count (one-byte varint)
+    seal(&mut b);
+    let e = load_err(&b);
+    assert!(e.contains("STEP") && e.contains("step 0"), "{e}");
+    let mut b = good.clone();
+    b.extend_from_slice(&[0; 16]);
+    seal(&mut b);
+    assert!(load_err(&b).contains("section table"));
+    // Every truncation and every single-byte flip (sealed) is an error or
+    // a valid model, never a panic.
+    for cut in (0..good.len()).step_by(7) {
+        let _ = MtsModel::from_bytes(&good[..cut], Path::new("cut.mts"));
+    }
+    for i in (32..good.len()).step_by(3) {
+        let mut b = good.clone();
+        b[i] ^= 0xa5;
+        seal(&mut b);
+        if let Ok(m) = MtsModel::from_bytes(&b, Path::new("flip.mts")) {
+            m.check().unwrap();
+            let mut ex = Extractor::new(&m);
+            ex.set_lod(m.max_lod() / 2);
+            assert_eq!(ex.overflows(), 0);
+        }
+    }
+}
+
+#[test]
+fn fuzz_findings_stay_fixed() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/regressions");
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return;
+    };
+    // Files here are load_mts findings; the loaders' findings sit in
+    // folders of their own (tests/hostile.rs reads them).
+    for e in entries.flatten().filter(|e| e.path().is_file()) {
+        let bytes = std::fs::read(e.path()).unwrap();
+        let mut sealed = bytes.clone();
+        seal(&mut sealed);
+        for b in [&bytes, &sealed] {
+            if let Ok(m) = MtsModel::from_bytes(b, &e.path()) {
+                m.check().unwrap();
+                let mut ex = Extractor::new(&m);
+                ex.set_lod(m.max_lod());
+                assert_eq!(ex.overflows(), 0);
+            }
+        }
+    }
+}
+
+#[test]
+fn bunny_quality_size_and_oracle() {
+    let Some(mesh) = model("bunny.ply") else {
+        return;
+    };
+    let m = build(&mesh, &SimplifyOptions::default(), &BuildOptions::default());
+    check_lods(&mesh, &m, 97);
+    let bytes = m.to_bytes().len();
+    assert!(
+        bytes * 2 <= m.raw_bytes() * 3,
+        "{bytes} bytes, raw {}",
+        m.raw_bytes()
+    );
+    let mut ex = Extractor::new(&m);
+    for ratio in [0.5, 0.25, 0.1, 0.05, 0.01] {
+        let lod = m.lod_for_ratio(ratio);
+        ex.set_lod(lod);
+        let fresh = stripify(
+            &m.collapses().mesh_at(&mesh, lod),
+            &StripifyOptions::default(),
+        );
+        let q = ex.indices_sent() as f64 / fresh.restart_index_count() as f64;
+        assert!(
+            q <= 1.15,
+            "{ratio}: {q:.3} x the indices of stripifying that level"
+        );
+    }
+}
+
+/// Every LoD of models up to this many triangles is verified; larger
+/// ones at [`SPREAD_LODS`] LoDs spread over the sequence.
+const EVERY_LOD_UP_TO: usize = 20_000;
+const SPREAD_LODS: usize = 200;
+
+fn verify_model(name: &str, mesh: &Mesh) {
+    let m = build(mesh, &SimplifyOptions::default(), &BuildOptions::default());
+    m.check().unwrap();
+    let n = (mesh.triangle_count() > EVERY_LOD_UP_TO).then_some(SPREAD_LODS);
+    let lods = mts::model::spread_lods(m.max_lod(), n);
+    let report = mts::model::verify(&m, mesh, &lods);
+    assert_eq!(report.lods_checked, lods.len(), "{name}");
+    assert!(report.lods_checked >= SPREAD_LODS.min(m.max_lod() + 1));
+    assert_eq!(
+        report.mismatches, 0,
+        "{name}: first mismatch {:?}",
+        report.first_mismatch
+    );
+}
+
+#[test]
+fn generated_meshes_hold_the_invariant() {
+    for g in ["icosphere:20k", "torus:8k", "grid:5k", "icosphere:80k"] {
+        let mesh: Mesh = g.parse::<Generated>().unwrap().build();
+        verify_model(g, &mesh);
+    }
+}
+
+#[test]
+fn real_models_hold_the_invariant() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        eprintln!("skipped: {} not found", dir.display());
+        return;
+    };
+    let mut names: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".ply") || n.ends_with(".obj"))
+        .collect();
+    names.sort();
+    assert!(!names.is_empty(), "no models in {}", dir.display());
+    for name in names {
+        let Some(mesh) = model(&name) else { continue };
+        verify_model(&name, &mesh);
+    }
+}
