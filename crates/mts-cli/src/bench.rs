@@ -10,7 +10,6 @@ use mts::distance::{surface_distance, Surface};
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
 use mts::peers;
 use mts::strip::acmr::{fifo_acmr, CACHE_SIZE};
-use mts::strip::encode::RESTART_U32;
 use mts::strip::stats::StripStats;
 use mts::{Extractor, Mesh, MtsModel, SimplifyOptions, StripifyOptions};
 use serde_json::{json, Value};
@@ -440,9 +439,7 @@ pub fn measure_levels(model: &MtsModel) -> Value {
             ex.write_compact(&mut compact);
             let level = model.collapses().mesh_at(&mesh, lod);
             let mut strip_triangles = Vec::new();
-            for run in compact.split(|&i| i == RESTART_U32) {
-                mts::strip::decode_run(run, &mut strip_triangles);
-            }
+            mts::encoding::decode_restart_buffer(&compact, &mut strip_triangles);
             let vertices = model.positions().len();
             let list_triangles =
                 peers::meshopt::optimize_vertex_cache(&level.triangles, level.vertex_count());

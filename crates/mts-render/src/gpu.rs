@@ -166,17 +166,3 @@ impl Gpu {
         AdapterReport::from_info(&self.adapter.get_info())
     }
 }
-
-/// Every adapter of every backend the environment allows, as reports (for
-/// `--list-adapters`-style diagnostics). Empty when there is none.
-///
-/// Cost: starts every driver once (blocking).
-#[must_use]
-pub fn available_adapters() -> Vec<AdapterReport> {
-    let instance =
-        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
-        .iter()
-        .map(|a| AdapterReport::from_info(&a.get_info()))
-        .collect()
-}

@@ -287,9 +287,7 @@ impl StripRenderer {
         let mut full = Vec::new();
         match source.topology() {
             mts::Topology::StripRestart => {
-                for run in source.indices().split(|&i| i == RESTART_U32) {
-                    mts::strip::decode_run(run, &mut full);
-                }
+                mts::encoding::decode_restart_buffer(source.indices(), &mut full);
             }
             mts::Topology::TriangleList => {
                 full.extend(source.indices().chunks_exact(3).map(|c| [c[0], c[1], c[2]]));

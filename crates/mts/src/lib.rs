@@ -31,6 +31,7 @@
 
 pub mod baselines;
 pub mod distance;
+pub mod encoding;
 pub mod error;
 pub mod lod;
 pub mod mesh;

@@ -29,13 +29,7 @@ pub fn bounds_of(positions: &[Vec3]) -> Option<(Vec3, Vec3)> {
     )
 }
 
-/// Whether a triangle repeats a vertex index (draws nothing). The one test
-/// used by loaders, cleaning, validation and strip decoding.
-#[must_use]
-#[inline]
-pub fn is_degenerate(t: [u32; 3]) -> bool {
-    t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
-}
+pub use crate::encoding::is_degenerate;
 
 /// An indexed triangle mesh.
 ///

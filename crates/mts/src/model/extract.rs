@@ -294,9 +294,7 @@ impl<'m> Extractor<'m> {
     #[must_use]
     pub fn triangles(&self) -> Vec<[u32; 3]> {
         let mut out = Vec::new();
-        for run in self.buffer.split(|&i| i == RESTART_U32) {
-            crate::strip::decode_run(run, &mut out);
-        }
+        crate::encoding::decode_restart_buffer(&self.buffer, &mut out);
         out
     }
 }

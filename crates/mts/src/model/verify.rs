@@ -24,8 +24,7 @@
 
 use super::{Extractor, MtsModel};
 use crate::mesh::{is_degenerate, Mesh};
-use crate::strip::encode::RESTART_U32;
-use crate::strip::{canonical_triangle, decode_run};
+use crate::strip::canonical_triangle;
 use std::collections::HashMap;
 use std::ops::Range;
 
@@ -150,9 +149,7 @@ fn first_difference(a: &Extractor<'_>, b: &Extractor<'_>) -> Option<usize> {
 
 /// The oriented triangles of `buffer[range]`, runs split at restarts.
 fn decode_range(buffer: &[u32], range: Range<usize>, out: &mut Vec<[u32; 3]>) {
-    for run in buffer[range].split(|&i| i == RESTART_U32) {
-        decode_run(run, out);
-    }
+    crate::encoding::decode_restart_buffer(&buffer[range], out);
 }
 
 /// Per oriented triangle (canonical rotation), drawn minus expected.

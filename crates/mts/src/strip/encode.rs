@@ -3,10 +3,7 @@
 
 use super::Strips;
 
-/// Restart value for `u32` index buffers.
-pub const RESTART_U32: u32 = u32::MAX;
-/// Restart value for `u16` index buffers.
-pub const RESTART_U16: u16 = u16::MAX;
+pub use crate::encoding::{RESTART_U16, RESTART_U32};
 
 impl Strips {
     /// One `u32` buffer, runs joined by [`RESTART_U32`].

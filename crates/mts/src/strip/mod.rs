@@ -7,12 +7,14 @@
 //! next triangle pivots on `x` instead of `y`. Decoding skips every window
 //! with a repeated vertex.
 
+pub use crate::encoding::{decode_restart_buffer, decode_run};
+
 pub mod acmr;
 pub mod encode;
 pub mod stats;
 pub mod stripify;
 
-pub use stripify::{stripify, stripify_with_adjacency, StripifyOptions};
+pub use stripify::{stripify, StripifyOptions};
 
 use crate::error::{Error, Result};
 use crate::mesh::is_degenerate;
@@ -181,20 +183,6 @@ impl Strips {
             }
         }
         Ok(())
-    }
-}
-
-/// Appends the oriented non-degenerate triangles of one run to `out`.
-///
-/// Triangle `i` is `(s[i], s[i+1], s[i+2])` for even `i` and
-/// `(s[i+1], s[i], s[i+2])` for odd `i`; windows with a repeated vertex are
-/// skipped.
-pub fn decode_run(run: &[u32], out: &mut Vec<[u32; 3]>) {
-    for (i, w) in run.windows(3).enumerate() {
-        let [a, b, c] = [w[0], w[1], w[2]];
-        if !is_degenerate([a, b, c]) {
-            out.push(if i % 2 == 0 { [a, b, c] } else { [b, a, c] });
-        }
     }
 }
 

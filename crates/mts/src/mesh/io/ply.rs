@@ -611,7 +611,7 @@ fn push_polygon(corners: &[i64], ids: &mut Vec<u32>, raw: &mut RawMesh) {
 }
 
 /// Decodes one `tristrips` list: runs split at `-1`, each decoded by the
-/// crate's one strip rule ([`crate::strip::decode_run`]); windows with a
+/// crate's one strip rule ([`crate::encoding::decode_run`]); windows with a
 /// repeated index (the strip's swaps) are dropped and counted. Indices were
 /// range-checked by the caller.
 fn push_strip(list: &[i64], run: &mut Vec<u32>, raw: &mut RawMesh) {
@@ -619,7 +619,7 @@ fn push_strip(list: &[i64], run: &mut Vec<u32>, raw: &mut RawMesh) {
         run.clear();
         run.extend(part.iter().map(|&i| i as u32));
         let before = raw.triangles.len();
-        crate::strip::decode_run(run, &mut raw.triangles);
+        crate::encoding::decode_run(run, &mut raw.triangles);
         let windows = run.len().saturating_sub(2);
         raw.degenerate_in_source += windows - (raw.triangles.len() - before);
     }

@@ -111,16 +111,6 @@ pub fn stripify(mesh: &Mesh, options: &StripifyOptions) -> Strips {
     }
 }
 
-/// [`stripify`] with an adjacency the caller already has.
-#[must_use]
-pub fn stripify_with_adjacency(
-    mesh: &Mesh,
-    adjacency: &TriangleAdjacency,
-    options: &StripifyOptions,
-) -> Strips {
-    stripify_impl(mesh, adjacency, None, options)
-}
-
 fn stripify_impl(
     mesh: &Mesh,
     adjacency: &TriangleAdjacency,
