@@ -21,7 +21,7 @@ use std::time::Instant;
 pub const SCHEMA_VERSION: u32 = 2;
 
 /// Shares of the full triangle count reported in Tables 3–4.
-const SHARES: [f64; 6] = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
+const SHARES: [f64; 6] = mts::methods::SHARES;
 /// Shares at which simplification quality is measured.
 const QUALITY_SHARES: [f64; 2] = [0.1, 0.01];
 /// Requests per Table 2 sequence (the full run; `--quick` uses fewer).
@@ -52,7 +52,7 @@ pub struct BenchOptions {
 }
 
 /// Shares of Figure 6, and its timed frames per point.
-const FIGURE6_SHARES: [f64; 6] = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
+const FIGURE6_SHARES: [f64; 6] = mts::methods::SHARES;
 const QUICK_FIGURE6_SHARES: [f64; 3] = [1.0, 0.25, 0.05];
 const FIGURE6_FRAMES: usize = 10;
 const QUICK_FIGURE6_FRAMES: usize = 4;
@@ -381,16 +381,8 @@ fn measure_model(
 /// interleaved (a drift of the machine's speed hits both alike), each
 /// pass from a fresh extractor whose construction is not timed.
 fn measure_sequences(model: &MtsModel, requests: usize) -> Value {
-    let max_lod = model.max_lod();
     let mut out = serde_json::Map::new();
-    for (seq, lods) in [
-        ("linear", sequence::linear(max_lod, requests)),
-        (
-            "exponential",
-            sequence::exponential(model.triangle_counts(), requests),
-        ),
-        ("random", sequence::random(max_lod, requests, 1)),
-    ] {
+    for (seq, lods) in sequence::table2(model.triangle_counts(), requests) {
         let n = lods.len().max(1) as f64;
         let pass = |coherent: bool| {
             let mut ex = Extractor::new(model);

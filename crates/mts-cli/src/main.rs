@@ -991,6 +991,18 @@ impl Method {
         Method::Cluster,
         Method::Discrete,
     ];
+
+    /// The core's method of the same name.
+    fn core(self) -> mts::methods::Method {
+        use mts::methods::Method as M;
+        match self {
+            Method::Mts => M::Mts,
+            Method::Pm => M::Pm,
+            Method::Multilevel => M::Multilevel,
+            Method::Cluster => M::Cluster,
+            Method::Discrete => M::Discrete,
+        }
+    }
 }
 
 /// The source of `method` over `model` (its mesh and contraction sequence).
@@ -999,20 +1011,7 @@ fn make_source<'m>(
     model: &'m mts::MtsModel,
     mesh: &Mesh,
 ) -> Result<Box<dyn mts::LodSource + 'm>> {
-    use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
-    let c = model.collapses();
-    Ok(match method {
-        Method::Mts => Box::new(mts::Extractor::new(model)),
-        Method::Pm => Box::new(ProgressiveMesh::new(mesh, c)?),
-        Method::Multilevel => Box::new(MultilevelMesh::new(mesh, c)?),
-        Method::Cluster => Box::new(ClusterTree::new(mesh)?),
-        Method::Discrete => {
-            if let Some(why) = peers::meshopt::refusal(mesh) {
-                bail!("the discrete LoDs are meshoptimizer's simplify: {why}");
-            }
-            Box::new(DiscreteLods::new(mesh, c.triangle_counts()))
-        }
-    })
+    Ok(method.core().source(model, mesh)?)
 }
 
 fn extract(args: &ExtractArgs) -> Result<()> {
@@ -1453,11 +1452,7 @@ fn measure_methods(
         let counts: Vec<u32> = (0..=max_lod)
             .map(|l| source.triangle_count(l) as u32)
             .collect();
-        let sequences = [
-            ("linear", sequence::linear(max_lod, requests)),
-            ("exponential", sequence::exponential(&counts, requests)),
-            ("random", sequence::random(max_lod, requests, 1)),
-        ];
+        let sequences = sequence::table2(&counts, requests);
         let mut us = serde_json::Map::new();
         for (label, lods) in &sequences {
             source.set_lod(max_lod);

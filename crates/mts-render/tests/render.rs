@@ -283,8 +283,7 @@ fn dirty_range_updates_equal_full_uploads() {
 
 #[test]
 fn baselines_through_upload_source_cover_what_the_oracle_covers() {
-    use mts::baselines::{MultilevelMesh, ProgressiveMesh};
-    use mts::LodSource;
+    use mts::methods::Method;
     let Some(gpu) = gpu() else { return };
     let mesh: Mesh = "torus:8k".parse::<Generated>().unwrap().build();
     let model = model_of(&mesh);
@@ -293,10 +292,7 @@ fn baselines_through_upload_source_cover_what_the_oracle_covers() {
     let (d, q) = (&gpu.device, &gpu.queue);
     let mut oracle = scene.renderer(&model, StripMode::Restart);
     let config = RendererConfig::headless(StripMode::Restart);
-    let sources: Vec<Box<dyn LodSource>> = vec![
-        Box::new(ProgressiveMesh::new(&mesh, model.collapses()).unwrap()),
-        Box::new(MultilevelMesh::new(&mesh, model.collapses()).unwrap()),
-    ];
+    let sources = [Method::Pm, Method::Multilevel].map(|m| m.source(&model, &mesh).unwrap());
     for mut source in sources {
         // The baseline's own vertex numbering: its own renderer.
         let mut renderer = StripRenderer::new(d, q, &config, source.positions(), &[]).unwrap();

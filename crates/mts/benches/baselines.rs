@@ -7,9 +7,9 @@
 mod common;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
+use mts::methods::Method;
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
-use mts::{Extractor, LodSource};
+use mts::LodSource;
 use std::hint::black_box;
 
 const REQUESTS: usize = 100;
@@ -17,14 +17,13 @@ const REQUESTS: usize = 100;
 fn bench(c: &mut Criterion) {
     let (name, mesh) = common::bunny_or_generated();
     let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
-    let collapses = model.collapses();
-    let mut sources: Vec<Box<dyn LodSource + '_>> = vec![
-        Box::new(Extractor::new(&model)),
-        Box::new(ProgressiveMesh::new(&mesh, collapses).expect("endpoint sequence")),
-        Box::new(MultilevelMesh::new(&mesh, collapses).expect("endpoint sequence")),
-        Box::new(ClusterTree::new(&mesh).expect("a mesh with vertices")),
-        Box::new(DiscreteLods::new(&mesh, collapses.triangle_counts())),
-    ];
+    let mut sources: Vec<Box<dyn LodSource + '_>> = Method::ALL
+        .iter()
+        .map(|m| {
+            m.source(&model, &mesh)
+                .expect("every method builds on the bench mesh")
+        })
+        .collect();
     for seq in ["linear", "exponential", "random"] {
         let mut group = c.benchmark_group(format!("lod_change/{name}/{seq}"));
         // Short: the machine is shared (warm-up 1 s, 2 s per method).
@@ -34,16 +33,13 @@ fn bench(c: &mut Criterion) {
         group.throughput(Throughput::Elements(REQUESTS as u64));
         for source in &mut sources {
             let max_lod = source.max_lod();
-            let lods = match seq {
-                "linear" => sequence::linear(max_lod, REQUESTS),
-                "exponential" => {
-                    let counts: Vec<u32> = (0..=max_lod)
-                        .map(|l| source.triangle_count(l) as u32)
-                        .collect();
-                    sequence::exponential(&counts, REQUESTS)
-                }
-                _ => sequence::random(max_lod, REQUESTS, 1),
-            };
+            let counts: Vec<u32> = (0..=max_lod)
+                .map(|l| source.triangle_count(l) as u32)
+                .collect();
+            let (_, lods) = sequence::table2(&counts, REQUESTS)
+                .into_iter()
+                .find(|(name, _)| *name == seq)
+                .expect("a Table 2 sequence");
             group.bench_function(source.name(), |b| {
                 b.iter(|| {
                     for &lod in &lods {

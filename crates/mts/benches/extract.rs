@@ -20,13 +20,11 @@ fn bench(c: &mut Criterion) {
     let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
     let max_lod = model.max_lod();
     let start = max_lod / 4;
+    let [linear, exponential, random] = sequence::table2(model.triangle_counts(), REQUESTS);
     let sequences = [
-        ("linear", sequence::linear(max_lod, REQUESTS)),
-        (
-            "exponential",
-            sequence::exponential(model.triangle_counts(), REQUESTS),
-        ),
-        ("random", sequence::random(max_lod, REQUESTS, 1)),
+        linear,
+        exponential,
+        random,
         (
             "consecutive",
             (start..(start + REQUESTS).min(max_lod + 1)).collect(),

@@ -30,11 +30,13 @@
 //! ```
 
 pub mod baselines;
+pub mod checksum;
 pub mod distance;
 pub mod encoding;
 pub mod error;
 pub mod lod;
 pub mod mesh;
+pub mod methods;
 pub mod model;
 #[cfg(feature = "peers")]
 pub mod peers;

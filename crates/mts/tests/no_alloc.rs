@@ -51,14 +51,12 @@ fn set_lod_allocates_nothing() {
     assert_eq!(ALLOCATIONS.load(Ordering::Relaxed) - before, 0);
 
     // The baselines, over the same sequence.
-    use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
-    use mts::LodSource;
-    let mut sources: Vec<Box<dyn LodSource>> = vec![
-        Box::new(ProgressiveMesh::new(&mesh, &collapses).unwrap()),
-        Box::new(MultilevelMesh::new(&mesh, &collapses).unwrap()),
-        Box::new(ClusterTree::new(&mesh).unwrap()),
-        Box::new(DiscreteLods::new(&mesh, collapses.triangle_counts())),
-    ];
+    use mts::methods::Method;
+    let mut sources: Vec<_> = Method::ALL
+        .iter()
+        .filter(|&&m| m != Method::Mts)
+        .map(|m| m.source(&model, &mesh).unwrap())
+        .collect();
     for source in &mut sources {
         source.set_lod(0);
         let max = source.max_lod();

@@ -14,7 +14,7 @@ use glam::Vec3;
 use std::ops::Range;
 
 /// Shares of the input's triangles kept by the levels, finest first.
-pub const RATIOS: [f64; 6] = [1.0, 0.5, 0.25, 0.1, 0.05, 0.01];
+pub const RATIOS: [f64; 6] = crate::methods::SHARES;
 
 /// Discrete LoDs: one index buffer per level, concatenated.
 ///

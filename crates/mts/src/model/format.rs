@@ -106,7 +106,7 @@ impl MtsModel {
         out.extend_from_slice(&VERSION.to_le_bytes());
         out.extend_from_slice(&(TAGS.len() as u32).to_le_bytes());
         out.extend_from_slice(&((HEADER_LEN + body.len()) as u64).to_le_bytes());
-        out.extend_from_slice(&fnv1a(&body).to_le_bytes());
+        out.extend_from_slice(&crate::checksum::fnv1a64(&body).to_le_bytes());
         out.extend_from_slice(&body);
         out
     }
@@ -164,7 +164,7 @@ pub fn seal(bytes: &mut [u8]) {
     }
     let len = bytes.len() as u64;
     bytes[16..24].copy_from_slice(&len.to_le_bytes());
-    let sum = fnv1a(&bytes[HEADER_LEN..]);
+    let sum = crate::checksum::fnv1a64(&bytes[HEADER_LEN..]);
     bytes[24..32].copy_from_slice(&sum.to_le_bytes());
 }
 
@@ -323,7 +323,7 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         ));
     }
     let body = &bytes[HEADER_LEN..];
-    let sum = fnv1a(body);
+    let sum = crate::checksum::fnv1a64(body);
     if u64_at(24) != sum {
         return Err(header(
             24,
@@ -622,16 +622,6 @@ fn zigzag(v: i64) -> u64 {
 
 fn unzigzag(v: u64) -> i64 {
     ((v >> 1) as i64) ^ -((v & 1) as i64)
-}
-
-/// FNV-1a, 64 bit.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
 }
 
 #[cfg(test)]

@@ -3,6 +3,20 @@
 //! their names; these definitions are ours, shared by the benches, `mts
 //! bench` and the baselines so every method sees the same requests.
 
+/// The three sequences of Table 2 by name, `n` requests each, over the LoD
+/// → triangle count table `counts` (`counts.len() - 1` is the coarsest
+/// LoD): linear, exponential and random (seed 1). What every measurement of
+/// LoD-change cost runs, so all methods see the same requests.
+#[must_use]
+pub fn table2(counts: &[u32], n: usize) -> [(&'static str, Vec<usize>); 3] {
+    let max_lod = counts.len().saturating_sub(1);
+    [
+        ("linear", linear(max_lod, n)),
+        ("exponential", exponential(counts, n)),
+        ("random", random(max_lod, n, 1)),
+    ]
+}
+
 /// `n` LoDs from the coarsest (`max_lod`) to the finest (0) in equal steps
 /// (`n = max_lod + 1` visits every LoD once).
 #[must_use]

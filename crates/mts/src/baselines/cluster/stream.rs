@@ -100,7 +100,7 @@ pub fn encode(pm: &ProgressiveMesh) -> Vec<u8> {
     for v in [n, pm.faces.len(), roots, base] {
         out.extend_from_slice(&(v as u32).to_le_bytes());
     }
-    out.extend_from_slice(&fnv1a32(&body).to_le_bytes());
+    out.extend_from_slice(&crate::checksum::fnv1a32(&body).to_le_bytes());
     out.extend_from_slice(&body);
     out
 }
@@ -230,7 +230,7 @@ fn decode_with(bytes: &[u8], file: &str, strict: bool) -> Result<Decoded> {
         ));
     }
     let body = &bytes[HEADER_BYTES..];
-    if strict && fnv1a32(body) != checksum {
+    if strict && crate::checksum::fnv1a32(body) != checksum {
         return Err(header_error(
             file,
             24,
@@ -401,14 +401,4 @@ fn push_triangle(d: &mut Decoded, holders: &mut [Vec<u32>], f: [u32; 3]) {
         holders[v as usize].push(j);
     }
     d.triangles.push(f);
-}
-
-/// FNV-1a, 32 bit.
-fn fnv1a32(bytes: &[u8]) -> u32 {
-    let mut h = 0x811c_9dc5u32;
-    for &b in bytes {
-        h ^= u32::from(b);
-        h = h.wrapping_mul(0x0100_0193);
-    }
-    h
 }
