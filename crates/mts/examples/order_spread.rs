@@ -11,7 +11,7 @@
 //! median and maximum: a median above 1 is a systematic gap, a single
 //! high order is tie noise.
 //!
-//! Run with `cargo run --release --example order_spread -- MESH SHARE
+//! Run with `cargo run --release -p mts --features peers --example order_spread -- MESH SHARE
 //! [ORDERS]`, e.g. `… -- ../shared/models/beetle.obj 0.1 6`; or with
 //! `-- --all DIR [ORDERS]` for every `.obj` and `.ply` in `DIR` at 10% and
 //! 1% (the 40 rows of the README table for `../shared/models`), followed

@@ -75,9 +75,9 @@ pub struct BuildOptions {
     /// band's first LoD. `f64::INFINITY` keeps one band: the paper's model.
     pub band_slack: f64,
     /// The stripifier used for every band after the first. The default is
-    /// the local pass alone with one swap penalty: on the bunny it builds
-    /// the 69 bands in 232 ms instead of 389 ms, for a worst strip-quality
-    /// ratio of 1.116 instead of 1.105 (ARCHITECTURE.md, "MTS model").
+    /// the local pass alone with one swap penalty: about 40% faster than the
+    /// full hybrid for a slightly worse worst strip-quality ratio
+    /// (`docs/experiments/bands.md`).
     pub stripify: StripifyOptions,
 }
 
@@ -265,8 +265,8 @@ impl Context<'_> {
     /// ends bands inside it, so the quality bound holds, while segments are
     /// independent and built in parallel. Halving segments balance two
     /// threads (the first holds about half the work, the rest the other
-    /// half) and cost about one extra band per halving (bunny: 85 bands
-    /// instead of 69; ARCHITECTURE.md has the measurements). The cut does
+    /// half) and cost about one extra band per halving
+    /// (`docs/experiments/bands.md`; `mts build --json` reports `bands`). The cut does
     /// not depend on the thread count, so the model does not either.
     /// With an infinite slack (the paper's single band) there is one
     /// segment.

@@ -15,8 +15,8 @@
 //! **Decision: slots are laid out per band, all bands over the same
 //! memory.** Only one band draws at any LoD, so each band's slots start at
 //! index 0 and the buffer is as long as the largest band (usually band 0,
-//! the input's strips), not the sum of all bands: the bunny's 75 bands
-//! need 84K indices instead of about 0.9M, which is what lets a scene keep
+//! the input's strips), not the sum of all bands: the bunny's bands need
+//! about a tenth of their sum (`docs/experiments/bands.md`), which lets a scene keep
 //! one extractor per instance. Changing band rewrites the band's region
 //! (one dirty range).
 
