@@ -12,9 +12,11 @@ use mts::checksum::fnv1a64;
 use mts::{Extractor, MtsModel};
 use std::path::Path;
 
-/// (file, max LoD, [(LoD, triangles, FNV-1a of the indices)]) at LoDs 0,
-/// max/4, max/2, 3·max/4 and max.
-const GOLDEN: [(&str, usize, [(usize, usize, u64); 5]); 3] = [
+/// (LoD, triangles, FNV-1a of the compact indices).
+type Row = (usize, usize, u64);
+
+/// (file, max LoD, rows at LoDs 0, max/4, max/2, 3·max/4 and max).
+const GOLDEN: [(&str, usize, [Row; 5]); 3] = [
     (
         "torus_500.mts",
         231,
