@@ -16,7 +16,7 @@ fuzz_target!(|data: &[u8]| {
         assert!(d.is_complete() && d.mesh().validate().is_ok());
     }
     if let Ok(mut pm) = ProgressiveMesh::from_bytes(data, "fuzz.pm") {
-        pm.validate();
+        pm.validate().unwrap();
         for lod in [0, pm.max_lod() / 2, pm.max_lod()] {
             pm.set_lod(lod);
         }

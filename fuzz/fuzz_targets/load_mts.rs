@@ -10,7 +10,7 @@ use mts::{Extractor, MtsModel};
 
 fn try_load(bytes: &[u8]) {
     if let Ok(model) = MtsModel::from_bytes(bytes, std::path::Path::new("fuzz.mts")) {
-        assert_eq!(model.check(), Ok(()));
+        assert_eq!(model.validate(), Ok(()));
         let mut ex = Extractor::new(&model);
         for lod in [0, model.max_lod() / 2, model.max_lod()] {
             ex.set_lod(lod);

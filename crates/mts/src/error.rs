@@ -125,11 +125,42 @@ pub enum Error {
     /// (tests, benches) skip on this one.
     #[error("no graphics adapter: {0}")]
     NoAdapter(String),
+    /// A structure's invariant is broken (see [`Invalid`]).
+    #[error(transparent)]
+    Invalid(#[from] Invalid),
     /// The GPU refused an operation: device creation, a resource beyond the
     /// adapter's limits, a failed readback.
     #[error("GPU: {0}")]
     Gpu(String),
 }
+
+/// A broken invariant of one of the crate's structures, as its `validate`
+/// reports it. Every structure with invariants (`Mesh`, `Strips`,
+/// `TriangleAdjacency`, `Collapses`, `MtsModel`, the baselines) has
+/// `validate(&self) -> Result<(), Invalid>` (`TriangleAdjacency` takes its
+/// mesh too); builders run it in debug builds, tests always.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("invalid {structure}: {message}")]
+pub struct Invalid {
+    /// The structure, e.g. `Collapses`.
+    pub structure: &'static str,
+    /// The first invariant found broken, and where.
+    pub message: String,
+}
+
+/// Returns `Err(Invalid)` from the enclosing `validate` when `cond` fails:
+/// `ensure!("Collapses", a < b, "step {i}: ...")`.
+macro_rules! ensure {
+    ($structure:expr, $cond:expr, $($message:tt)+) => {
+        if !$cond {
+            return Err($crate::error::Invalid {
+                structure: $structure,
+                message: format!($($message)+),
+            });
+        }
+    };
+}
+pub(crate) use ensure;
 
 /// `Result` with the crate's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;

@@ -43,7 +43,7 @@ pub mod peers;
 pub mod simplify;
 pub mod strip;
 
-pub use error::{Error, Place, Result};
+pub use error::{Error, Invalid, Place, Result};
 pub use lod::{LodSource, Topology};
 pub use mesh::Mesh;
 pub use model::{Extractor, MtsModel};

@@ -82,7 +82,7 @@ fn pm_matches_the_oracle_at_every_lod_of_a_torus() {
     assert_eq!(mesh.triangle_count(), 1936);
     for lods in orders(c.max_lod()) {
         let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
-        pm.validate();
+        pm.validate().unwrap();
         check_against_oracle(&mesh, &c, &mut pm, &lods);
     }
 }
@@ -94,7 +94,7 @@ fn pm_file_round_trips_and_rejects_damage() {
     let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
     let bytes = pm.to_bytes();
     let mut back = ProgressiveMesh::from_bytes(&bytes, "torus.pm").unwrap();
-    back.validate();
+    back.validate().unwrap();
     assert_eq!(back.to_bytes(), bytes);
     for lod in [0, 1, 100, c.max_lod() / 2, c.max_lod()] {
         pm.set_lod(lod);
@@ -124,7 +124,7 @@ fn pm_file_round_trips_and_rejects_damage() {
         let mut b = bytes.clone();
         b[at] ^= 0x5a;
         if let Ok(pm) = ProgressiveMesh::from_bytes(&b, "flip.pm") {
-            pm.validate();
+            pm.validate().unwrap();
         }
     }
 }
@@ -135,7 +135,7 @@ fn multilevel_matches_the_oracle_at_every_lod_of_a_torus() {
     let c = collapses(&mesh);
     for lods in orders(c.max_lod()) {
         let mut ml = MultilevelMesh::new(&mesh, &c).unwrap();
-        ml.validate();
+        ml.validate().unwrap();
         check_against_oracle(&mesh, &c, &mut ml, &lods);
     }
 }
@@ -485,8 +485,8 @@ proptest! {
         let c = collapses(&mesh);
         let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
         let mut ml = MultilevelMesh::new(&mesh, &c).unwrap();
-        pm.validate();
-        ml.validate();
+        pm.validate().unwrap();
+        ml.validate().unwrap();
         let mut lods: Vec<usize> = (0..=c.max_lod()).collect();
         lods.extend(sequence::random(c.max_lod(), 20, 5));
         check_against_oracle(&mesh, &c, &mut pm, &lods);

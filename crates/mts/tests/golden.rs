@@ -67,7 +67,7 @@ fn golden_files_load_as_they_always_did() {
     let mut same = true;
     for (file, max_lod, rows) in GOLDEN {
         let model = MtsModel::load(&dir.join(file)).unwrap_or_else(|e| panic!("{e}"));
-        model.check().unwrap();
+        model.validate().unwrap();
         let max = model.max_lod();
         let mut got = Vec::new();
         for lod in [0, max / 4, max / 2, 3 * max / 4, max] {

@@ -101,7 +101,7 @@ fn coincident_triangles_pair_rank_by_rank() {
         triangles,
     };
     let adjacency = TriangleAdjacency::new(&m);
-    adjacency.validate(&m);
+    adjacency.validate(&m).unwrap();
     for t in 0..350 {
         let paired = adjacency.neighbours[t]
             .iter()

@@ -58,7 +58,7 @@ fn rule(run: &[u32]) -> Vec<u32> {
 /// to from-scratch output, the compact count, and (single band) the naive
 /// rule strip by strip. Dirty ranges cover every changed index.
 fn check_lods(mesh: &Mesh, m: &MtsModel, step: usize) {
-    m.check().unwrap();
+    m.validate().unwrap();
     let collapses: &Collapses = m.collapses();
     let mut coherent = Extractor::new(m);
     let mut scratch = Extractor::new(m);
@@ -294,7 +294,7 @@ fn corrupt_files_get_errors_naming_the_place() {
         b[i] ^= 0xa5;
         seal(&mut b);
         if let Ok(m) = MtsModel::from_bytes(&b, Path::new("flip.mts")) {
-            m.check().unwrap();
+            m.validate().unwrap();
             let mut ex = Extractor::new(&m);
             ex.set_lod(m.max_lod() / 2);
             assert_eq!(ex.overflows(), 0);
@@ -316,7 +316,7 @@ fn fuzz_findings_stay_fixed() {
         seal(&mut sealed);
         for b in [&bytes, &sealed] {
             if let Ok(m) = MtsModel::from_bytes(b, &e.path()) {
-                m.check().unwrap();
+                m.validate().unwrap();
                 let mut ex = Extractor::new(&m);
                 ex.set_lod(m.max_lod());
                 assert_eq!(ex.overflows(), 0);
@@ -361,7 +361,7 @@ const SPREAD_LODS: usize = 200;
 
 fn verify_model(name: &str, mesh: &Mesh) {
     let m = build(mesh, &SimplifyOptions::default(), &BuildOptions::default());
-    m.check().unwrap();
+    m.validate().unwrap();
     let n = (mesh.triangle_count() > EVERY_LOD_UP_TO).then_some(SPREAD_LODS);
     let lods = mts::model::spread_lods(m.max_lod(), n);
     let report = mts::model::verify(&m, mesh, &lods);

@@ -27,7 +27,7 @@ fn mesh(triangles: Vec<[u32; 3]>) -> Mesh {
 /// Asserts the invariant for every encoding and returns the strips.
 fn check(mesh: &Mesh, options: &StripifyOptions) -> Strips {
     let strips = stripify(mesh, options);
-    strips.validate();
+    strips.validate().unwrap();
     let expected = sorted_canonical(&mesh.triangles);
     assert_eq!(
         sorted_canonical(&strips.triangles()),

@@ -13,6 +13,7 @@
 //! LoD `k` then uses vertices `0..n - k` and the triangles whose death
 //! exceeds `k`.
 
+use crate::error::ensure;
 use crate::error::{Error, Result};
 use crate::mesh::{is_degenerate, Mesh};
 use crate::simplify::Collapses;
@@ -108,7 +109,7 @@ impl Levels {
             alive,
         };
         if cfg!(debug_assertions) {
-            levels.validate();
+            assert_eq!(levels.validate(), Ok(()));
             assert_eq!(levels.alive, collapses.triangle_counts(), "alive table");
         }
         Ok(levels)
@@ -121,27 +122,40 @@ impl Levels {
 
     /// Checks the invariants listed on [`Levels`].
     ///
-    /// # Panics
-    /// With a message naming the first broken invariant.
-    pub(crate) fn validate(&self) {
+    /// # Errors
+    /// [`crate::Invalid`] naming the first broken invariant.
+    pub(crate) fn validate(&self) -> std::result::Result<(), crate::Invalid> {
         for (i, &v) in self.order.iter().enumerate() {
-            assert_eq!(self.rank[v as usize] as usize, i, "order and rank");
+            ensure!(
+                "Levels",
+                self.rank[v as usize] as usize == i,
+                "order and rank"
+            );
         }
         for (v, &p) in self.parent.iter().enumerate() {
             if v < self.roots {
-                assert_eq!(p as usize, v, "root {v} has a parent");
+                ensure!("Levels", p as usize == v, "root {v} has a parent");
             } else {
-                assert!((p as usize) < v, "vertex {v}: parent {p} is not older");
+                ensure!(
+                    "Levels",
+                    (p as usize) < v,
+                    "vertex {v}: parent {p} is not older"
+                );
             }
         }
-        assert!(self.death.windows(2).all(|w| w[0] >= w[1]), "death order");
+        ensure!(
+            "Levels",
+            self.death.windows(2).all(|w| w[0] >= w[1]),
+            "death order"
+        );
         for (k, &a) in self.alive.iter().enumerate() {
-            assert_eq!(
-                a as usize,
-                self.death.partition_point(|&d| d as usize > k),
+            ensure!(
+                "Levels",
+                a as usize == self.death.partition_point(|&d| d as usize > k),
                 "alive at {k}"
             );
         }
+        Ok(())
     }
 }
 

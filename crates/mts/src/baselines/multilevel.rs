@@ -24,6 +24,7 @@
 //!   paper's Figure 5 does.
 
 use super::levels::Levels;
+use crate::error::ensure;
 use crate::error::Result;
 use crate::lod::{LodSource, Topology};
 use crate::mesh::{is_degenerate, Mesh};
@@ -125,9 +126,7 @@ impl MultilevelMesh {
             lod: None,
             dirty: Vec::with_capacity(3 * t / (DIRTY_GAP + 1) + 2),
         };
-        if cfg!(debug_assertions) {
-            m.validate();
-        }
+        debug_assert_eq!(m.validate(), Ok(()));
         Ok(m)
     }
 
@@ -227,13 +226,14 @@ impl MultilevelMesh {
 
     /// Checks the invariants listed on [`MultilevelMesh`].
     ///
-    /// # Panics
-    /// With a message naming the first broken invariant.
-    pub fn validate(&self) {
+    /// # Errors
+    /// [`crate::Invalid`] naming the first broken invariant.
+    pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
         let n = self.positions.len();
         for j in 0..n - self.roots {
             let v = self.roots + j;
-            assert!(
+            ensure!(
+                "MultilevelMesh",
                 (self.representatives.get(j) as usize) < v,
                 "vertex {v}: representative not older"
             );
@@ -243,13 +243,14 @@ impl MultilevelMesh {
             let alive = self.count_at(k);
             for t in 0..self.total_triangles() {
                 let tri = [0, 1, 2].map(|c| self.root_below(self.triangles.get(3 * t + c), n_k));
-                assert_eq!(
-                    is_degenerate(tri),
-                    t >= alive,
+                ensure!(
+                    "MultilevelMesh",
+                    is_degenerate(tri) == (t >= alive),
                     "LoD {k}: triangle {t} out of level order"
                 );
             }
         }
+        Ok(())
     }
 
     /// Triangles alive at `lod` by binary search with the forest. O(log T

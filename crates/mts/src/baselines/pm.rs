@@ -18,6 +18,7 @@
 
 use super::bits::{width_for, BitReader, BitWriter};
 use super::levels::Levels;
+use crate::error::ensure;
 use crate::error::Result;
 use crate::lod::{LodSource, Topology};
 use crate::mesh::{is_degenerate, Mesh};
@@ -158,9 +159,7 @@ impl ProgressiveMesh {
             state: 0,
             written,
         };
-        if cfg!(debug_assertions) {
-            pm.validate();
-        }
+        debug_assert_eq!(pm.validate(), Ok(()));
         pm
     }
 
@@ -209,35 +208,55 @@ impl ProgressiveMesh {
 
     /// Checks the invariants listed on [`ProgressiveMesh`].
     ///
-    /// # Panics
-    /// With a message naming the first broken invariant.
-    pub fn validate(&self) {
+    /// # Errors
+    /// [`crate::Invalid`] naming the first broken invariant.
+    pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
         let n = self.positions.len();
         let max_lod = self.kept.len();
-        assert_eq!(self.alive.len(), max_lod + 1, "alive table length");
-        assert_eq!(self.alive[0] as usize, self.faces.len(), "alive at LoD 0");
-        assert!(
+        ensure!(
+            "ProgressiveMesh",
+            self.alive.len() == max_lod + 1,
+            "alive table length"
+        );
+        ensure!(
+            "ProgressiveMesh",
+            self.alive[0] as usize == self.faces.len(),
+            "alive at LoD 0"
+        );
+        ensure!(
+            "ProgressiveMesh",
             self.alive.windows(2).all(|w| w[0] >= w[1]),
             "alive increases"
         );
-        assert_eq!(self.corner_start.len(), max_lod + 1, "corner offsets");
-        assert_eq!(self.list.len(), 3 * self.faces.len(), "list length");
+        ensure!(
+            "ProgressiveMesh",
+            self.corner_start.len() == max_lod + 1,
+            "corner offsets"
+        );
+        ensure!(
+            "ProgressiveMesh",
+            self.list.len() == 3 * self.faces.len(),
+            "list length"
+        );
         for i in 0..max_lod {
             let r = (n - 1 - i) as u32;
-            assert!(
+            ensure!(
+                "ProgressiveMesh",
                 self.kept[i] < r,
                 "step {i}: kept {} not older than {r}",
                 self.kept[i]
             );
             for t in self.alive[i + 1]..self.alive[i] {
                 let f = self.faces[t as usize];
-                assert!(
+                ensure!(
+                    "ProgressiveMesh",
                     f.contains(&r) && f.contains(&self.kept[i]),
                     "step {i}: face {t} {f:?}"
                 );
             }
             for c in self.corners_of(i) {
-                assert!(
+                ensure!(
+                    "ProgressiveMesh",
                     self.corners[c] < 3 * self.alive[i + 1],
                     "step {i}: corner out of range"
                 );
@@ -245,13 +264,15 @@ impl ProgressiveMesh {
         }
         let base = self.alive[max_lod] as usize;
         let roots = n - max_lod;
-        assert!(
+        ensure!(
+            "ProgressiveMesh",
             self.faces[..base]
                 .iter()
                 .flatten()
                 .all(|&v| (v as usize) < roots),
             "base mesh uses a removed vertex"
         );
+        Ok(())
     }
 
     /// The compact file: header, positions in level order, the base mesh,

@@ -12,6 +12,7 @@
 //! neighbour, so no triangle is ever flipped.
 
 use super::Mesh;
+use crate::error::ensure;
 
 /// Corners around one vertex above which the pairing sorts them
 /// (O(k log k)) instead of counting ranks by scanning (O(k²), faster for
@@ -113,8 +114,7 @@ impl TriangleAdjacency {
             }
         }
         let adjacency = TriangleAdjacency { neighbours, mates };
-        #[cfg(debug_assertions)]
-        adjacency.validate(mesh);
+        debug_assert_eq!(adjacency.validate(mesh), Ok(()));
         adjacency
     }
 
@@ -138,10 +138,14 @@ impl TriangleAdjacency {
 
     /// Asserts the symmetry invariant documented on the type.
     ///
-    /// # Panics
-    /// When the invariant is broken (an internal error).
-    pub fn validate(&self, mesh: &Mesh) {
-        assert_eq!(self.neighbours.len(), mesh.triangle_count());
+    /// # Errors
+    /// [`crate::Invalid`] naming the first broken invariant.
+    pub fn validate(&self, mesh: &Mesh) -> std::result::Result<(), crate::Invalid> {
+        ensure!(
+            "TriangleAdjacency",
+            self.neighbours.len() == mesh.triangle_count(),
+            "self.neighbours.len() == mesh.triangle_count()"
+        );
         for (t, ns) in self.neighbours.iter().enumerate() {
             for (slot, &u) in ns.iter().enumerate() {
                 if u == NO_NEIGHBOUR {
@@ -151,16 +155,19 @@ impl TriangleAdjacency {
                 let (a, b) = (tri[slot], tri[(slot + 1) % 3]);
                 let tu = mesh.triangles[u as usize];
                 let j = self.mate(t as u32, slot);
-                assert!(
+                ensure!(
+                    "TriangleAdjacency",
                     tu[j] == b && tu[(j + 1) % 3] == a,
                     "the mate slot does not hold the reversed edge"
                 );
-                assert_eq!(
-                    self.neighbours[u as usize][j], t as u32,
+                ensure!(
+                    "TriangleAdjacency",
+                    self.neighbours[u as usize][j] == t as u32,
                     "adjacency not symmetric"
                 );
             }
         }
+        Ok(())
     }
 }
 

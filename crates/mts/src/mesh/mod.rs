@@ -14,7 +14,6 @@ pub mod io;
 pub use adjacency::{TriangleAdjacency, NO_NEIGHBOUR};
 pub use clean::{clean, CleanOptions, CleanReport, RawMesh};
 
-use crate::error::{Error, Result};
 use glam::Vec3;
 
 /// Axis-aligned bounds `(min, max)` of `positions`; `None` when empty.
@@ -136,10 +135,10 @@ impl Mesh {
     /// Checks the invariants listed on [`Mesh`].
     ///
     /// # Errors
-    /// [`Error::InvalidMesh`] naming the first offending vertex or triangle.
-    pub fn validate(&self) -> Result<()> {
-        let bad = |message: String| Error::InvalidMesh {
-            source_name: "mesh".into(),
+    /// [`crate::Invalid`] naming the first offending vertex or triangle.
+    pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
+        let bad = |message: String| crate::Invalid {
+            structure: "Mesh",
             message,
         };
         if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {

@@ -239,7 +239,7 @@ pub fn build_with_progress(
             options: options.clone(),
         },
     };
-    debug_assert_eq!(model.check(), Ok(()));
+    debug_assert_eq!(model.validate(), Ok(()));
     model
 }
 

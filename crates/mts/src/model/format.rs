@@ -147,9 +147,14 @@ impl MtsModel {
             &recipe.collapses,
             &recipe.options,
         );
-        model
-            .check()
-            .map_err(|m| parse_error(file, 0, "model", format!("built model is invalid: {m}")))?;
+        model.validate().map_err(|e| {
+            parse_error(
+                file,
+                0,
+                "model",
+                format!("built model is invalid: {}", e.message),
+            )
+        })?;
         Ok(model)
     }
 }

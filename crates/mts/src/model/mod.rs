@@ -258,12 +258,18 @@ impl MtsModel {
         self.strip_begins[s] as usize..self.strip_begins[s + 1] as usize
     }
 
-    /// Checks the invariants listed on [`MtsModel`]; the message names the
-    /// first one broken (strip, node or arc).
+    /// Checks the invariants listed on [`MtsModel`].
     ///
     /// # Errors
-    /// A description of the first broken invariant.
-    pub fn check(&self) -> Result<(), String> {
+    /// [`crate::Invalid`] naming the first broken one (strip, node or arc).
+    pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
+        self.check_parts().map_err(|message| crate::Invalid {
+            structure: "MtsModel",
+            message,
+        })
+    }
+
+    fn check_parts(&self) -> Result<(), String> {
         let max_lod = self.max_lod() as u32;
         check_offsets("strip node", &self.strip_nodes, self.node_vertex.len())?;
         check_offsets("strip beginning", &self.strip_begins, self.begin_node.len())?;

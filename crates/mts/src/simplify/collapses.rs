@@ -9,6 +9,7 @@
 //! representatives"); [`Collapses::representatives`] path-compresses it for
 //! one LoD into the paper's *pc-rep* array.
 
+use crate::error::ensure;
 use crate::mesh::{is_degenerate, Mesh};
 use glam::Vec3;
 
@@ -61,8 +62,8 @@ impl Collapses {
     /// the invariants; `triangle_counts[k]` is the triangle count at LoD `k`.
     ///
     /// # Panics
-    /// If the steps break an invariant listed on [`Collapses`] (a bug in the
-    /// caller, not bad input).
+    /// In debug builds, if the steps break an invariant listed on
+    /// [`Collapses`] (a bug in the caller, not bad input).
     #[must_use]
     pub(crate) fn new(
         vertex_count: usize,
@@ -96,7 +97,7 @@ impl Collapses {
             parent,
             parent_from_lod,
         };
-        c.validate();
+        debug_assert_eq!(c.validate(), Ok(()));
         c
     }
 
@@ -267,58 +268,72 @@ impl Collapses {
 
     /// Checks the invariants listed on [`Collapses`].
     ///
-    /// # Panics
-    /// With a message naming the first broken invariant.
-    pub fn validate(&self) {
+    /// # Errors
+    /// [`crate::Invalid`] naming the first broken invariant.
+    pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
         let total = self.vertex_count + self.appended.len();
-        assert_eq!(
-            self.triangle_counts.len(),
-            self.steps.len() + 1,
+        ensure!(
+            "Collapses",
+            self.triangle_counts.len() == self.steps.len() + 1,
             "table length"
         );
-        assert!(
+        ensure!(
+            "Collapses",
             self.triangle_counts.windows(2).all(|w| w[0] >= w[1]),
             "triangle counts increase"
         );
-        assert!(self.appended.is_empty() || self.appended.len() == self.steps.len());
+        ensure!(
+            "Collapses",
+            self.appended.is_empty() || self.appended.len() == self.steps.len(),
+            "self.appended.is_empty() || self.appended.len() == self.steps.len()"
+        );
         let mut removed_at = vec![u32::MAX; total];
         let mut last_error = 0.0f32;
         for (i, s) in self.steps.iter().enumerate() {
             let (r, k) = (s.removed as usize, s.kept as usize);
-            assert!(
+            ensure!(
+                "Collapses",
                 r < total && k < total && r != k,
                 "step {i}: bad vertices {s:?}"
             );
-            assert_eq!(
-                removed_at[r],
-                u32::MAX,
+            ensure!(
+                "Collapses",
+                removed_at[r] == u32::MAX,
                 "step {i}: vertex {r} removed twice"
             );
-            assert_eq!(
-                removed_at[k],
-                u32::MAX,
+            ensure!(
+                "Collapses",
+                removed_at[k] == u32::MAX,
                 "step {i}: kept vertex {k} already removed"
             );
             removed_at[r] = i as u32;
             let target = self.target(i);
-            assert!(
+            ensure!(
+                "Collapses",
                 !self.is_optimal_placement() || (r.max(k) < target as usize),
                 "step {i}: uses a vertex created later"
             );
             if self.is_optimal_placement() {
                 removed_at[k] = i as u32;
-                assert_eq!(
-                    self.parent[k], target,
+                ensure!(
+                    "Collapses",
+                    self.parent[k] == target,
                     "step {i}: forest link of the kept endpoint"
                 );
             }
-            assert!(
+            ensure!(
+                "Collapses",
                 s.error.is_finite() && s.error >= last_error,
                 "step {i}: error decreases"
             );
             last_error = s.error;
-            assert_eq!(self.parent[r], target, "step {i}: forest link");
+            ensure!(
+                "Collapses",
+                self.parent[r] == target,
+                "step {i}: forest link"
+            );
         }
+        Ok(())
     }
 }
 

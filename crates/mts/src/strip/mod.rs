@@ -57,7 +57,9 @@ impl Strips {
             strips.starts.push(strips.indices.len() as u32);
         }
         strips.triangle_count = strips.runs().map(run_triangle_count).sum();
-        strips.check()?;
+        strips
+            .validate()
+            .map_err(|e| Error::InvalidArgument(e.message))?;
         Ok(strips)
     }
 
@@ -78,7 +80,7 @@ impl Strips {
         };
         #[cfg(debug_assertions)]
         {
-            strips.validate();
+            assert_eq!(strips.validate(), Ok(()));
             assert_eq!(
                 strips.runs().map(run_triangle_count).sum::<usize>(),
                 triangle_count
@@ -157,29 +159,26 @@ impl Strips {
         out
     }
 
-    /// Checks the invariants listed on [`Strips`].
+    /// Checks the invariants listed on [`Strips`]: every run has at least
+    /// three vertices, every index is below the vertex count.
     ///
-    /// # Panics
-    /// If one is broken (an internal error).
-    pub fn validate(&self) {
-        if let Err(e) = self.check() {
-            panic!("invalid strips: {e}");
-        }
-    }
-
-    fn check(&self) -> Result<()> {
+    /// # Errors
+    /// [`crate::Invalid`] naming the first broken one.
+    pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
         for (i, run) in self.runs().enumerate() {
-            if run.len() < 3 {
-                return Err(Error::InvalidArgument(format!(
-                    "run {i} has {} vertices",
-                    run.len()
-                )));
-            }
+            crate::error::ensure!(
+                "Strips",
+                run.len() >= 3,
+                "run {i} has {} vertices",
+                run.len()
+            );
             if let Some(v) = run.iter().find(|&&v| v >= self.vertex_count) {
-                return Err(Error::InvalidArgument(format!(
+                crate::error::ensure!(
+                    "Strips",
+                    false,
                     "run {i} uses vertex {v} of {}",
                     self.vertex_count
-                )));
+                );
             }
         }
         Ok(())
