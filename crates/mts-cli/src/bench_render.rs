@@ -213,7 +213,7 @@ pub fn scene_row(
     instances: usize,
     frames: usize,
 ) -> Result<Option<serde_json::Value>> {
-    use mts_render::InstancedScene;
+    use crate::demo_scene::DemoScene;
     let per_instance = 4 * Extractor::new(model).buffer().len();
     if per_instance.saturating_mul(instances) > SCENE_MEMORY_CAP {
         eprintln!(
@@ -223,17 +223,17 @@ pub fn scene_row(
         );
         return Ok(None);
     }
-    let mut scene = InstancedScene::new(&gpu.device, &gpu.queue, config, model, instances)?;
+    let mut scene = DemoScene::new(&gpu.device, &gpu.queue, config, model, instances)?;
     let camera = scene.overview_camera(target.aspect());
     let (width, height) = target.size();
     let t = Instant::now();
-    let first = scene.update(&gpu.queue, &camera, height as f32);
+    let first = scene.update(&gpu.device, &gpu.queue, &camera, height as f32)?;
     let first_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut times = Vec::with_capacity(frames);
     let mut stats = first;
     for i in 0..frames.max(1) + 2 {
         let t = Instant::now();
-        stats = scene.update(&gpu.queue, &camera, height as f32);
+        stats = scene.update(&gpu.device, &gpu.queue, &camera, height as f32)?;
         target.render(&gpu.device, &gpu.queue, |pass| scene.draw(pass))?;
         if i >= 2 {
             times.push(t.elapsed().as_secs_f64() * 1e3);

@@ -15,6 +15,7 @@ mod bench;
 mod bench_render;
 mod charts;
 mod demo;
+mod demo_scene;
 mod figure6;
 mod render;
 mod summary;

@@ -221,23 +221,23 @@ fn print_text(
 const SCENE_FRAMES: usize = 5;
 
 fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -> Result<()> {
-    use mts_render::InstancedScene;
+    use crate::demo_scene::DemoScene;
     let Size(width, height) = args.size;
     let gpu = Gpu::new_headless()?;
     let report = gpu.report();
     let config = RendererConfig::headless(report.strip_mode);
     let (device, queue) = (&gpu.device, &gpu.queue);
     let target = HeadlessTarget::new(device, width, height)?;
-    let mut scene = InstancedScene::new(device, queue, &config, model, count)?;
+    let mut scene = DemoScene::new(device, queue, &config, model, count)?;
     let camera = scene.overview_camera(target.aspect());
     let t = Instant::now();
-    let first = scene.update(queue, &camera, height as f32);
+    let first = scene.update(device, queue, &camera, height as f32)?;
     let ms_first_update = t.elapsed().as_secs_f64() * 1e3;
     let mut times = Vec::new();
     let mut stats = first;
     for _ in 0..SCENE_FRAMES {
         let t = Instant::now();
-        stats = scene.update(queue, &camera, height as f32);
+        stats = scene.update(device, queue, &camera, height as f32)?;
         target.render(device, queue, |pass| scene.draw(pass))?;
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
@@ -253,6 +253,7 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
                 "input": name,
                 "adapter": report.name,
                 "backend": format!("{:?}", report.backend),
+                "strip_mode": report.strip_mode.to_string(),
                 "device_type": format!("{:?}", report.device_type),
                 "instances": count,
                 "visible": stats.visible,

@@ -1,5 +1,5 @@
 //! `mts view`: a window (winit) with an orbit camera around one model, or
-//! an [`InstancedScene`], drawn by the same renderer as everything else.
+//! the demo layout ([`DemoScene`]) of an `InstancedScene`, drawn by the same renderer as everything else.
 //!
 //! Controls: drag with the left button (or the arrow keys) to orbit, `W`/`S`
 //! to move closer or farther; the mouse wheel, `Up`/`Down` or `+`/`-`
@@ -9,12 +9,13 @@
 //! title shows triangles, indices sent, the last extraction's microseconds
 //! and frames per second.
 
+use crate::demo_scene::DemoScene;
 use glam::Vec3;
 use mts::model::Extractor;
 use mts::{Error, MtsModel, Result};
 use mts_render::camera::Camera;
 use mts_render::gpu::AdapterReport;
-use mts_render::scene::{InstancedScene, PIXELS_PER_TRIANGLE};
+use mts_render::scene::PIXELS_PER_TRIANGLE;
 use mts_render::strip_renderer::{RendererConfig, StripRenderer};
 use std::sync::Arc;
 use std::time::Instant;
@@ -59,7 +60,7 @@ pub struct ViewerReport {
 /// # Errors
 /// [`Error::Gpu`] when no window, surface, adapter or device can be
 /// created (no display, or no adapter that can present to it), and the
-/// errors of [`StripRenderer::for_model`] and [`InstancedScene::new`].
+/// errors of [`StripRenderer::for_model`] and [`DemoScene::new`].
 pub fn run(
     model: &MtsModel,
     content: ViewerContent,
@@ -135,7 +136,7 @@ enum Drawn<'m> {
         renderer: StripRenderer,
         extractor: Extractor<'m>,
     },
-    Scene(InstancedScene<'m>),
+    Scene(DemoScene<'m>),
 }
 
 /// Orbit camera around `centre`: yaw and pitch in radians, distance in
@@ -316,11 +317,15 @@ impl<'m> State<'m> {
             }
             ViewerContent::Scene(n) => {
                 // Stitched on backends that ignore primitive restart.
-                let scene = InstancedScene::new(&device, &queue, &renderer_config, model, n)?;
-                let (lo, hi) = scene.instances().iter().fold(
-                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                    |(lo, hi), i| (lo.min(i.centre), hi.max(i.centre)),
-                );
+                let scene = DemoScene::new(&device, &queue, &renderer_config, model, n)?;
+                let (lo, hi) = scene
+                    .instances
+                    .iter()
+                    .filter_map(|&i| scene.scene.bounds_of(i))
+                    .fold(
+                        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                        |(lo, hi), (c, _)| (lo.min(c), hi.max(c)),
+                    );
                 let radius = ((hi - lo).length() * 0.5).max(1e-6);
                 (Drawn::Scene(scene), (lo + hi) * 0.5, radius)
             }
@@ -398,7 +403,12 @@ impl<'m> State<'m> {
                 (model.triangle_count(lod), extractor.indices_sent())
             }
             Drawn::Scene(scene) => {
-                let stats = scene.update(&self.queue, &camera, h as f32);
+                let stats = scene
+                    .update(&self.device, &self.queue, &camera, h as f32)
+                    .unwrap_or_else(|e| {
+                        eprintln!("scene update: {e}");
+                        mts_render::FrameStats::default()
+                    });
                 if stats.lod_changes > 0 {
                     self.extract_us = t.elapsed().as_secs_f64() * 1e6;
                 }

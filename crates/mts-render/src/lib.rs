@@ -25,7 +25,7 @@ pub mod strip_renderer;
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{HeadlessTarget, Image};
-pub use scene::{FrameStats, Instance, InstancedScene};
+pub use scene::{FrameStats, InstanceId, InstancedScene, ModelId};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload};
 /// The wgpu this renderer is built with, so that embedders use the same
 /// version.

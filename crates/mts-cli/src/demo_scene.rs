@@ -1,0 +1,138 @@
+//! The demo layout of `mts render --scene`, `mts view --scene` and the
+//! bench's scene row: `count` instances of one model on a square grid on a
+//! ground plane, and a camera above one corner looking across the field.
+//! The renderer's [`InstancedScene`] knows nothing of it: a host places its
+//! own instances.
+
+use glam::{Mat4, Vec3};
+use mts::{MtsModel, Result};
+use mts_render::{
+    Camera, FrameStats, InstanceId, InstancedScene, ModelId, RendererConfig, StripRenderer,
+};
+
+/// Linear RGB of the ground plane (a muted green-grey, apart from the
+/// models' colour).
+pub const GROUND_COLOUR: Vec3 = Vec3::new(0.22, 0.27, 0.22);
+
+/// `count` instances of one model on a ground plane.
+pub struct DemoScene<'m> {
+    pub scene: InstancedScene<'m>,
+    pub model: ModelId,
+    pub instances: Vec<InstanceId>,
+    ground: StripRenderer,
+    /// Extent of the field: min and max corner on the ground.
+    field: (Vec3, Vec3),
+}
+
+impl<'m> DemoScene<'m> {
+    /// Places `count` instances of `model` on a square grid on the plane
+    /// y = 0 (each resting on it, turned about +y by a fixed pseudo-random
+    /// angle), spaced 2.5 model diameters apart, with a ground quad under
+    /// them.
+    ///
+    /// # Errors
+    /// As [`InstancedScene::add_model`] and [`InstancedScene::add_instance`].
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: &RendererConfig,
+        model: &'m MtsModel,
+        count: usize,
+    ) -> Result<DemoScene<'m>> {
+        if count == 0 {
+            return Err(mts::Error::InvalidArgument(
+                "a scene needs instances".into(),
+            ));
+        }
+        let mut scene = InstancedScene::new(config);
+        let id = scene.add_model(device, queue, model)?;
+        let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
+        let radius = ((mts::mesh::diagonal_of(min, max) * 0.5) as f32).max(f32::MIN_POSITIVE);
+        let spacing = 5.0 * radius;
+        let side = (count as f64).sqrt().ceil() as usize;
+        let mut instances = Vec::with_capacity(count);
+        for i in 0..count {
+            let (gx, gz) = ((i % side) as f32, (i / side) as f32);
+            let angle = std::f32::consts::TAU * hash01(i as u32);
+            // Rest on the plane: the lowest point of the box at y = 0.
+            let at = Vec3::new(gx * spacing, -min.y, gz * spacing);
+            let transform = Mat4::from_translation(at) * Mat4::from_rotation_y(angle);
+            instances.push(scene.add_instance(id, transform)?);
+        }
+        let far = (side.max(1) - 1) as f32 * spacing;
+        let margin = 1.5 * spacing;
+        let field = (
+            Vec3::new(-margin, 0.0, -margin),
+            Vec3::new(far + margin, 0.0, far + margin),
+        );
+        let (a, b) = field;
+        let ground_positions = [
+            Vec3::new(a.x, 0.0, a.z),
+            Vec3::new(b.x, 0.0, a.z),
+            Vec3::new(b.x, 0.0, b.z),
+            Vec3::new(a.x, 0.0, b.z),
+        ];
+        // Counter-clockwise seen from above (+y).
+        let ground_triangles = [[0, 2, 1], [0, 3, 2]];
+        let mut ground =
+            StripRenderer::new(device, queue, config, &ground_positions, &ground_triangles)?;
+        ground.upload_list(device, queue, &ground_triangles)?;
+        ground.set_colour(GROUND_COLOUR);
+        Ok(DemoScene {
+            scene,
+            model: id,
+            instances,
+            ground,
+            field,
+        })
+    }
+
+    /// A camera above one corner of the field looking across it, so that
+    /// instances range from near (fine LoDs) to far (coarse ones) and some
+    /// fall outside the view. `aspect` is width / height.
+    #[must_use]
+    pub fn overview_camera(&self, aspect: f32) -> Camera {
+        let (a, b) = self.field;
+        let size = (b - a).length();
+        let eye = Vec3::new(a.x, 0.05 * size, a.z) + Vec3::new(0.08, 0.0, 0.08) * size;
+        let target = a + (b - a) * Vec3::new(0.55, 0.0, 0.45);
+        Camera::looking(eye, target, aspect, 0.01 * size, 2.0 * size)
+    }
+
+    /// The scene's update ([`InstancedScene::update`]) and the ground's
+    /// camera.
+    ///
+    /// # Errors
+    /// As [`InstancedScene::update`].
+    pub fn update(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        camera: &Camera,
+        viewport_height: f32,
+    ) -> Result<FrameStats> {
+        self.ground.set_camera(queue, camera);
+        self.scene.update(device, queue, camera, viewport_height)
+    }
+
+    /// The ground, then the instances.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        self.ground.draw(pass);
+        self.scene.draw(pass);
+    }
+
+    /// CPU and GPU bytes per instance.
+    #[must_use]
+    pub fn bytes_per_instance(&self) -> (usize, usize) {
+        self.scene.bytes_per_instance(self.model)
+    }
+}
+
+/// A fixed pseudo-random number in 0..1 from `i` (integer hash).
+fn hash01(i: u32) -> f32 {
+    let mut x = i.wrapping_mul(0x9E37_79B9) ^ 0x85EB_CA6B;
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7FEB_352D);
+    x ^= x >> 15;
+    (x >> 8) as f32 / (1u32 << 24) as f32
+}
