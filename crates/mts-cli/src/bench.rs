@@ -987,11 +987,16 @@ pub fn report(results: &Value) -> String {
     s
 }
 
-/// Writes `report.md` and `results.json` into `dir` (created if needed).
+/// Writes `report.md` and `results.json` into `dir` (created if needed),
+/// after checking `results` against the typed layout
+/// ([`crate::results::Results`]): a key the bench failed to write, or a
+/// NaN it produced, stops here with the key named.
 pub fn write(dir: &Path, results: &Value) -> Result<()> {
+    let typed = crate::results::Results::from_value(results.clone())?;
+    let results = &typed.to_value();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let json_path = dir.join("results.json");
-    std::fs::write(&json_path, serde_json::to_string_pretty(results)?)
+    std::fs::write(&json_path, serde_json::to_string_pretty(&typed)?)
         .with_context(|| format!("cannot write {}", json_path.display()))?;
     let charts = super::charts::write_all(dir, results)?;
     let mut text = report(results);

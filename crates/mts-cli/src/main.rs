@@ -14,10 +14,12 @@ use std::time::Instant;
 mod bench;
 mod bench_render;
 mod charts;
+mod check;
 mod demo;
 mod demo_scene;
 mod figure6;
 mod render;
+mod results;
 mod summary;
 mod viewer;
 
@@ -95,6 +97,45 @@ enum BenchCommand {
     /// The README's "Latest bench report" section, made from a report's
     /// results.json.
     Summary(SummaryArgs),
+    /// Load a results.json through its typed layout and check the
+    /// invariants CI holds a run to; exits non-zero naming each broken one.
+    Check(CheckArgs),
+}
+
+#[derive(Args)]
+struct CheckArgs {
+    /// The report's results.json.
+    results: PathBuf,
+    /// The layout of `mts bench --quick` (one model, no scale section).
+    #[arg(long)]
+    quick: bool,
+}
+
+fn bench_check(args: &CheckArgs) -> Result<()> {
+    let r = results::Results::load(&args.results)?;
+    let bad = check::check(&r, args.quick);
+    if !bad.is_empty() {
+        bail!(
+            "{}: {} broken:\n  {}",
+            args.results.display(),
+            bad.len(),
+            bad.join("\n  ")
+        );
+    }
+    match &r.machine.adapter {
+        Some(a) => println!(
+            "{}: complete ({} models; Figure 6 and the scene on {a})",
+            args.results.display(),
+            r.models.len()
+        ),
+        None => println!(
+            "{}: complete ({} models; no adapter: {})",
+            args.results.display(),
+            r.models.len(),
+            r.machine.adapter_note.as_deref().unwrap_or("?")
+        ),
+    }
+    Ok(())
 }
 
 #[derive(Args)]
@@ -112,18 +153,7 @@ struct SummaryArgs {
 
 fn bench_summary(args: &SummaryArgs) -> Result<()> {
     let path = &args.results;
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let results: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{} is not a bench results.json", path.display()))?;
-    if results["schema"].as_u64() != Some(u64::from(bench::SCHEMA_VERSION)) {
-        bail!(
-            "{}: schema {} where this build reads {} (run mts bench again)",
-            path.display(),
-            results["schema"],
-            bench::SCHEMA_VERSION
-        );
-    }
+    let results = results::Results::load(path)?.to_value();
     let Some(readme) = &args.readme else {
         let dir = path
             .parent()
@@ -191,6 +221,7 @@ fn bench_cmd(args: &BenchArgs) -> Result<()> {
     match &args.command {
         Some(BenchCommand::Render(args)) => return bench_render::bench_render(args),
         Some(BenchCommand::Summary(args)) => return bench_summary(args),
+        Some(BenchCommand::Check(args)) => return bench_check(args),
         None => {}
     }
     let mut models = Vec::new();

@@ -1,0 +1,200 @@
+//! `mts bench check results.json [--quick]`: the invariants CI holds a
+//! bench run to, on the typed results (loading already proves every key is
+//! there with its type): counts agree across sections, every time and size
+//! is positive, the shares and methods are the report's, strips send fewer
+//! indices than the list at every level, and Figure 6 and the scene ran
+//! wherever an adapter was found.
+
+use crate::results::{FastSimplificationRun, MethodRow, Results};
+use mts::methods::{Method, SHARES};
+
+/// The broken invariants of `r`, each naming its model and section (empty
+/// when all hold). `quick`: the layout of `mts bench --quick` (one model,
+/// no scale section, the scene of 250 instances).
+pub fn check(r: &Results, quick: bool) -> Vec<String> {
+    let mut bad = Vec::new();
+    let mut need = |ok: bool, what: String| {
+        if !ok {
+            bad.push(what);
+        }
+    };
+    need(
+        r.elapsed_s > 0.0,
+        format!("elapsed_s {} is not positive", r.elapsed_s),
+    );
+    need(
+        r.quick == quick,
+        format!("quick is {}, expected {quick}", r.quick),
+    );
+    if quick {
+        need(
+            r.models.len() == 1,
+            format!("{} models, --quick measures one", r.models.len()),
+        );
+        need(r.scale.is_none(), "--quick has no scale section".into());
+        need(
+            r.fast_simplification.is_none(),
+            "--quick runs no fast-simplification".into(),
+        );
+    } else {
+        need(!r.models.is_empty(), "no model measured".into());
+        need(r.scale.is_some(), "no scale section".into());
+    }
+    if let Some(FastSimplificationRun::Rows(rows)) = &r.fast_simplification {
+        for f in rows {
+            need(
+                f.ms > 0.0 && f.triangles > 0,
+                format!("fast_simplification {}: empty row", f.mesh),
+            );
+        }
+    }
+    let methods: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+    for m in &r.models {
+        let at = |section: &str| format!("{}: {section}", m.name);
+        let st = &m.stripify;
+        need(
+            st.mts.triangles == m.triangles && st.meshopt.triangles == m.triangles,
+            at("stripify triangles differ from the model's"),
+        );
+        need(
+            st.mts.indices_per_triangle >= 1.0 && st.mts.ms > 0.0 && st.meshopt.ms > 0.0,
+            at("stripify indices per triangle below 1 or no time"),
+        );
+        need(
+            m.simplify.ms > 0.0 && m.simplify.max_lod == m.max_lod,
+            at("simplify: no time, or its max_lod is not the model's"),
+        );
+        let b = &m.bytes;
+        need(
+            b.raw > 0 && b.raw_u16 > 0 && b.mts_file > 0 && b.mts_memory > 0,
+            at("bytes: a size is 0"),
+        );
+        for seq in ["linear", "exponential", "random"] {
+            match m.extraction.get(seq) {
+                Some(e) => need(
+                    e.mts_coherent_us > 0.0 && e.mts_scratch_us > 0.0,
+                    at(&format!("extraction {seq}: no time")),
+                ),
+                None => need(false, at(&format!("extraction has no {seq} sequence"))),
+            }
+        }
+        let shares: Vec<f64> = m.levels.iter().map(|l| l.share).collect();
+        need(
+            shares == SHARES,
+            at(&format!("levels at shares {shares:?}, not {SHARES:?}")),
+        );
+        for l in &m.levels {
+            need(
+                0 < l.mts_indices && l.mts_indices < l.list_indices,
+                at(&format!(
+                    "level {}: strips send {} indices, the list {}",
+                    l.share, l.mts_indices, l.list_indices
+                )),
+            );
+        }
+        let quality: Vec<f64> = m.quality.iter().map(|q| q.share).collect();
+        need(
+            quality == [0.1, 0.01],
+            at(&format!("quality at shares {quality:?}")),
+        );
+        let names: Vec<&str> = m
+            .methods
+            .iter()
+            .map(|x| match x {
+                MethodRow::Measured(x) => x.method.as_str(),
+                MethodRow::Skipped { method, .. } => method.as_str(),
+            })
+            .collect();
+        need(
+            names == methods,
+            at(&format!("methods {names:?}, not {methods:?}")),
+        );
+        for x in &m.methods {
+            if let MethodRow::Measured(x) = x {
+                need(
+                    x.file_bytes > 0 && x.memory_bytes > 0,
+                    at(&format!("method {}: a size is 0", x.method)),
+                );
+            }
+        }
+        match (&r.machine.adapter, &m.figure6) {
+            (Some(_), Some(f)) => {
+                let shares = if quick { 3 } else { SHARES.len() };
+                // Every method and the list, each in both modes.
+                let expected = shares * (Method::ALL.len() + 1) * 2;
+                need(
+                    f.rows.len() == expected,
+                    at(&format!(
+                        "figure6 has {} rows, not {expected}",
+                        f.rows.len()
+                    )),
+                );
+                need(
+                    f.rows.iter().all(|x| x.fps > 0.0 && x.draw_ms > 0.0),
+                    at("figure6: a row without frames"),
+                );
+                need(
+                    f.rows
+                        .iter()
+                        .filter(|x| x.method == "mts" && x.mode == "immediate")
+                        .all(|x| x.change_us.is_some_and(|c| c > 0.0)),
+                    at("figure6: an MTS change without its cost"),
+                );
+            }
+            (Some(_), None) => need(false, at("an adapter ran but no Figure 6")),
+            (None, _) => {}
+        }
+    }
+    if r.machine.adapter.is_some() {
+        match &r.scene {
+            Some(sc) => {
+                if quick {
+                    need(
+                        sc.instances == 250,
+                        format!("scene of {} instances, not 250", sc.instances),
+                    );
+                }
+                need(
+                    0 < sc.visible && sc.visible <= sc.instances && sc.ms_per_frame > 0.0,
+                    format!(
+                        "scene: {} of {} visible, {} ms",
+                        sc.visible, sc.instances, sc.ms_per_frame
+                    ),
+                );
+            }
+            None => need(false, "an adapter ran but no scene".into()),
+        }
+    }
+    bad
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn committed() -> Results {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../docs/report/results.json"
+        );
+        Results::load(std::path::Path::new(path)).unwrap()
+    }
+
+    #[test]
+    fn the_committed_report_holds_and_a_broken_one_is_named() {
+        let r = committed();
+        assert_eq!(check(&r, false), Vec::<String>::new());
+        assert!(check(&r, true).iter().any(|e| e.contains("quick is false")));
+        let mut broken = r.clone();
+        let name = broken.models[3].name.clone();
+        let level = &mut broken.models[3].levels[2];
+        level.mts_indices = level.list_indices;
+        broken.models[0].simplify.max_lod += 1;
+        let bad = check(&broken, false);
+        assert_eq!(bad.len(), 2, "{bad:?}");
+        assert!(
+            bad[0].contains("simplify") && bad[1].starts_with(&name),
+            "{bad:?}"
+        );
+    }
+}

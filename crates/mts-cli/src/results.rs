@@ -1,0 +1,383 @@
+//! `results.json` as one typed structure (`docs/bench-schema.md`): what
+//! `mts bench` writes, and what `mts bench summary`, the charts,
+//! `mts bench check` and the README test read. A missing, renamed or extra
+//! key, or a `null` where a number belongs (a NaN the writer produced), is
+//! a load error naming the key and its place — never a NaN in a table.
+
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The whole file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Results {
+    pub schema: u32,
+    pub command: String,
+    pub elapsed_s: f64,
+    pub quick: bool,
+    pub machine: Machine,
+    pub models: Vec<Model>,
+    /// `null` with `--quick`.
+    pub scale: Option<Scale>,
+    /// `null` with `--quick`; rows, or why they are missing.
+    pub fast_simplification: Option<FastSimplificationRun>,
+    /// `null` without an adapter.
+    pub scene: Option<Scene>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Machine {
+    pub cpu: String,
+    pub cores: u32,
+    pub os: String,
+    pub adapter: Option<String>,
+    pub adapter_note: Option<String>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Model {
+    pub name: String,
+    pub triangles: u64,
+    pub vertices: u64,
+    pub strips: u64,
+    pub max_lod: u64,
+    pub bands: u64,
+    pub bytes: Bytes,
+    pub build_ms: BuildMs,
+    pub stripify: Stripify,
+    pub simplify: Simplify,
+    pub extraction: BTreeMap<String, Extraction>,
+    pub levels: Vec<Level>,
+    pub quality: Vec<Quality>,
+    pub methods: Vec<MethodRow>,
+    /// `null` without an adapter.
+    pub figure6: Option<Figure6>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bytes {
+    pub raw: u64,
+    pub raw_u16: u64,
+    pub mts_file: u64,
+    pub mts_memory: u64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BuildMs {
+    pub stripify: f64,
+    pub simplify: f64,
+    pub model: f64,
+    pub total: f64,
+}
+
+/// One stripifier's row (`mts strips`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StripRow {
+    pub triangles: u64,
+    pub strips: u64,
+    pub swaps: u64,
+    pub indices_restart: u64,
+    pub indices_per_triangle: f64,
+    pub acmr: f64,
+    pub ms: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stripify {
+    #[serde(flatten)]
+    pub mts: StripRow,
+    pub meshopt: StripRow,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Simplify {
+    pub ms: f64,
+    pub max_lod: u64,
+    pub stop: String,
+    pub meshopt_ms_to_10: f64,
+    pub meshopt_ms_to_1: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Extraction {
+    pub requests: u64,
+    pub mts_coherent_us: f64,
+    pub mts_scratch_us: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Level {
+    pub share: f64,
+    pub lod: u64,
+    pub triangles: u64,
+    pub mts_indices: u64,
+    pub list_indices: u64,
+    pub meshopt_strip_indices: u64,
+    pub mts_acmr: f64,
+    pub list_acmr: f64,
+    pub meshopt_strip_acmr: f64,
+    pub extract_us: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Quality {
+    pub share: f64,
+    pub mts: Distance,
+    pub meshopt: PeerDistance,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Distance {
+    pub triangles: u64,
+    pub hausdorff: f64,
+    pub rms: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeerDistance {
+    pub triangles: u64,
+    pub hausdorff: f64,
+    pub rms: f64,
+    pub ms: f64,
+}
+
+/// A method measured, or skipped with the reason (meshoptimizer's discrete
+/// LoDs on a mesh where its time would be quadratic).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum MethodRow {
+    Measured(Method),
+    Skipped { method: String, skipped: String },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Method {
+    pub method: String,
+    pub build_ms: f64,
+    pub memory_bytes: u64,
+    pub file_bytes: u64,
+    pub file_ratio_to_raw_u16: f64,
+    pub us_per_change: BTreeMap<String, f64>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Figure6 {
+    pub width: u32,
+    pub height: u32,
+    pub frames: u64,
+    pub rows: Vec<Figure6Row>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Figure6Row {
+    pub method: String,
+    pub mode: String,
+    pub share: f64,
+    pub lod: u64,
+    pub triangles: u64,
+    pub indices_sent: u64,
+    pub draw_ms: f64,
+    pub fps: f64,
+    /// The LoD change's cost: `null` in the per-second mode.
+    pub change_us: Option<f64>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scale {
+    pub rows: Vec<ScaleRow>,
+    pub exponent: ScaleExponent,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScaleRow {
+    pub triangles: u64,
+    pub stripify_ms: f64,
+    pub meshopt_stripify_ms: f64,
+    pub simplify_ms: f64,
+    pub meshopt_simplify_to_10_ms: f64,
+    pub build_ms: f64,
+    pub model_bytes: u64,
+    pub extract_lod0_us: f64,
+    pub peak_rss_bytes: u64,
+}
+
+/// Fitted growth exponents of the scale rows (time or bytes ∝ n^e).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScaleExponent {
+    pub stripify_ms: f64,
+    pub meshopt_stripify_ms: f64,
+    pub simplify_ms: f64,
+    pub meshopt_simplify_to_10_ms: f64,
+    pub build_ms: f64,
+    pub model_bytes: f64,
+    pub extract_lod0_us: f64,
+}
+
+/// The fast-simplification peer's rows, or why there are none.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum FastSimplificationRun {
+    Rows(Vec<FastSimplification>),
+    Skipped { skipped: String },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FastSimplification {
+    pub mesh: String,
+    pub ratio: f64,
+    pub input_triangles: u64,
+    pub triangles: u64,
+    pub ms: f64,
+    pub hausdorff: f64,
+    pub rms: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    pub model: String,
+    pub instances: u64,
+    pub width: u32,
+    pub height: u32,
+    pub visible: u64,
+    pub triangles: u64,
+    pub indices_sent: u64,
+    pub cpu_bytes_per_instance: u64,
+    pub ms_first_update: f64,
+    pub ms_per_frame: f64,
+    pub fps: f64,
+    pub triangles_per_second: f64,
+}
+
+impl Results {
+    /// The typed form of what the bench assembled, or an error naming the
+    /// first key that is missing, extra or of the wrong type.
+    ///
+    /// # Errors
+    /// When `value` is not this layout.
+    pub fn from_value(value: serde_json::Value) -> Result<Results> {
+        serde_path_to_error::deserialize(value)
+            .map_err(|e| anyhow::anyhow!("results.json layout: at `{}`: {}", e.path(), e.inner()))
+    }
+
+    /// Reads and checks `path` (the layout and the schema version).
+    ///
+    /// # Errors
+    /// When the file cannot be read, is not this layout (the error names the
+    /// key) or has another schema version.
+    pub fn load(path: &Path) -> Result<Results> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let mut de = serde_json::Deserializer::from_str(&text);
+        let results: Results = serde_path_to_error::deserialize(&mut de)
+            .map_err(|e| anyhow::anyhow!("{}: at `{}`: {}", path.display(), e.path(), e.inner()))?;
+        if results.schema != crate::bench::SCHEMA_VERSION {
+            anyhow::bail!(
+                "{}: schema {} where this build reads {} (run mts bench again)",
+                path.display(),
+                results.schema,
+                crate::bench::SCHEMA_VERSION
+            );
+        }
+        Ok(results)
+    }
+
+    /// The untyped view the report's writers read.
+    #[must_use]
+    pub fn to_value(&self) -> serde_json::Value {
+        serde_json::to_value(self).expect("a typed result serialises")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn committed() -> serde_json::Value {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../docs/report/results.json"
+        );
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    }
+
+    /// The committed report loads, and writing it back gives the same JSON.
+    #[test]
+    fn the_committed_report_round_trips() {
+        let value = committed();
+        let typed = Results::from_value(value.clone()).unwrap();
+        assert_eq!(typed.to_value(), value);
+    }
+
+    /// A renamed key and a NaN written as null are errors that name where.
+    #[test]
+    fn a_renamed_key_or_a_null_is_named() {
+        let mut value = committed();
+        let bytes = value["models"][0]["bytes"].as_object_mut().unwrap();
+        let raw = bytes.remove("raw").unwrap();
+        bytes.insert("raw_bytes".into(), raw);
+        let e = Results::from_value(value).unwrap_err().to_string();
+        assert!(
+            e.contains("models[0].bytes") && e.contains("raw_bytes"),
+            "{e}"
+        );
+        let mut value = committed();
+        value["models"][0]["levels"][2]["mts_acmr"] = serde_json::Value::Null;
+        let e = Results::from_value(value).unwrap_err().to_string();
+        assert!(e.contains("models[0].levels[2].mts_acmr"), "{e}");
+    }
+
+    /// Every key of the layout is documented in `docs/bench-schema.md`.
+    #[test]
+    fn every_key_is_in_the_schema_doc() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/bench-schema.md");
+        let doc = std::fs::read_to_string(path).unwrap();
+        fn keys(v: &serde_json::Value, out: &mut std::collections::BTreeSet<String>) {
+            match v {
+                serde_json::Value::Object(m) => {
+                    for (k, x) in m {
+                        out.insert(k.clone());
+                        keys(x, out);
+                    }
+                }
+                serde_json::Value::Array(a) => a.iter().for_each(|x| keys(x, out)),
+                _ => {}
+            }
+        }
+        let mut all = std::collections::BTreeSet::new();
+        keys(
+            &Results::from_value(committed()).unwrap().to_value(),
+            &mut all,
+        );
+        let missing: Vec<_> = all
+            .iter()
+            .filter(|k| !doc.contains(&format!("\"{k}\"")) && !doc.contains(&format!("{k}:")))
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "not in docs/bench-schema.md: {missing:?}"
+        );
+        assert!(all.len() > 80, "{} keys", all.len());
+    }
+}
