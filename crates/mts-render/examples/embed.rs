@@ -1,10 +1,16 @@
-//! `StripRenderer` inside a caller's own wgpu code: the caller owns the
-//! instance, device, queue, target texture and render pass; the renderer
-//! only uploads vertices once, then after each LoD change the index ranges
-//! the extractor rewrote, and records its draw.
+//! mts-render inside a caller's own wgpu code: the caller owns the
+//! instance, device, queue, target texture and render pass.
 //!
-//! Run with `cargo run --release --example embed` (lavapipe is enough).
+//! First one `StripRenderer`: it uploads vertices once, then after each LoD
+//! change the index ranges the extractor rewrote, and records its draw.
+//! Then an `InstancedScene` the host drives: two models, instances placed,
+//! moved every frame, removed and added, each given its LoD by its
+//! projected size, culled, drawn in the host's pass.
+//!
+//! Run with `cargo run --release -p mts-render --example embed` (lavapipe
+//! is enough).
 
+use glam::{Mat4, Vec3};
 use mts::mesh::generate::Generated;
 use mts::model::{build, BuildOptions};
 use mts::{stripify, Extractor, Mesh, SimplifyOptions, StripifyOptions};
@@ -82,35 +88,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
         // The caller's frame: its encoder, its pass, the renderer's draw.
         let t = Instant::now();
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("frame"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &color,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            renderer.draw(&mut pass);
-        }
-        queue.submit([encoder.finish()]);
-        device.poll(wgpu::PollType::wait_indefinitely())?;
+        frame(&device, &queue, &color, &depth, |pass| renderer.draw(pass))?;
         let frame_ms = t.elapsed().as_secs_f64() * 1e3;
         println!(
             "ratio {ratio:4}: LoD {:5}, {:5} triangles, {:2} strips walked, \
@@ -125,5 +103,106 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             extractor.indices_sent(),
         );
     }
+
+    // The scene: two models, 300 instances on a ring that turns a little
+    // every frame; every tenth frame some leave and others arrive.
+    let sphere: Mesh = "icosphere:5k".parse::<Generated>()?.build();
+    let sphere_model = build(
+        &sphere,
+        &stripify(&sphere, &StripifyOptions::default()),
+        &mts::simplify(&sphere, &SimplifyOptions::default()).collapses,
+        &BuildOptions::default(),
+    );
+    let mut scene = mts_render::InstancedScene::new(&config);
+    let models = [
+        scene.add_model(&device, &queue, &model)?,
+        scene.add_model(&device, &queue, &sphere_model)?,
+    ];
+    let place = |i: usize, turn: f32| {
+        let angle = i as f32 * 0.021 + turn;
+        let radius = 12.0 + (i % 7) as f32 * 3.0;
+        Mat4::from_translation(Vec3::new(angle.cos(), 0.0, angle.sin()) * radius)
+    };
+    let mut live: Vec<(usize, mts_render::InstanceId)> = (0..300)
+        .map(|i| Ok((i, scene.add_instance(models[i % 2], place(i, 0.0))?)))
+        .collect::<mts::Result<_>>()?;
+    let camera = Camera::looking(
+        Vec3::new(0.0, 18.0, 45.0),
+        Vec3::ZERO,
+        640.0 / 480.0,
+        0.1,
+        200.0,
+    );
+    for step in 0..30 {
+        let turn = step as f32 * 0.05;
+        for &(i, id) in &live {
+            scene.set_transform(id, place(i, turn))?;
+        }
+        if step % 10 == 9 {
+            // Twenty leave, twenty new ones arrive.
+            for (_, id) in live.drain(..20) {
+                scene.remove_instance(id);
+            }
+            for i in 300 + step * 20..320 + step * 20 {
+                live.push((i, scene.add_instance(models[i % 2], place(i, turn))?));
+            }
+        }
+        let t = Instant::now();
+        let stats = scene.update(&device, &queue, &camera, 480.0)?;
+        let update_ms = t.elapsed().as_secs_f64() * 1e3;
+        frame(&device, &queue, &color, &depth, |pass| scene.draw(pass))?;
+        if step % 5 == 0 || step % 10 == 9 {
+            println!(
+                "scene frame {step:2}: {} instances, {} visible, {} triangles, {} LoD changes, \
+                 {} bytes uploaded; update {update_ms:.2} ms",
+                scene.instance_count(),
+                stats.visible,
+                stats.triangles,
+                stats.lod_changes,
+                stats.upload_bytes
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The caller's frame: its encoder, its pass (cleared colour and depth),
+/// `draw` recording into it, submitted and waited for.
+fn frame(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    color: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+    draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("frame"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: color,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        draw(&mut pass);
+    }
+    queue.submit([encoder.finish()]);
+    device.poll(wgpu::PollType::wait_indefinitely())?;
     Ok(())
 }
