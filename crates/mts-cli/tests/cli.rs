@@ -2,24 +2,9 @@
 //! `extract` at a LoD, triangle budget and ratio, `verify` passing on a
 //! sound model and failing (non-zero exit, named place) on a corrupt file.
 
-use serde_json::Value;
-use std::process::Command;
+mod common;
 
-fn mts(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_mts"))
-        .args(args)
-        .output()
-        .expect("the mts binary runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn json(text: &str) -> Value {
-    serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"))
-}
+use common::{json, mts};
 
 #[test]
 fn build_extract_verify_round_trip() {

@@ -2,19 +2,10 @@
 //! its smallest case (the library's cases are in the core crate's
 //! `tests/hostile.rs`; `scripts/hostile.py` generates thousands more).
 
-use std::process::Command;
+mod common;
 
-fn mts_cli(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_mts"))
-        .args(args)
-        .output()
-        .expect("the mts binary runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::mts as mts_cli;
+use std::process::Command;
 
 /// A refused argument: exit non-zero, no panic, `expected` in the message.
 fn refused(args: &[&str], expected: &str) {
