@@ -998,7 +998,7 @@ pub fn write(dir: &Path, results: &Value) -> Result<()> {
     let json_path = dir.join("results.json");
     std::fs::write(&json_path, serde_json::to_string_pretty(&typed)?)
         .with_context(|| format!("cannot write {}", json_path.display()))?;
-    let charts = super::charts::write_all(dir, results)?;
+    let charts = super::charts::write_all(dir, &typed)?;
     let mut text = report(results);
     if !charts.is_empty() {
         let _ = writeln!(text, "\n## Charts\n");

@@ -1,9 +1,9 @@
 //! PNG charts of `mts bench`'s results (plotters, bitmap backend, DejaVu
 //! Sans embedded so no system font is needed).
 
+use crate::results::{Figure6Row, Level, Model, Results, ScaleRow};
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
-use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 const SIZE: (u32, u32) = (900, 560);
@@ -19,30 +19,30 @@ fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
 }
 
 /// Writes every chart the results allow into `dir`; returns their paths.
-pub fn write_all(dir: &Path, results: &Value) -> Result<Vec<PathBuf>> {
+pub fn write_all(dir: &Path, results: &Results) -> Result<Vec<PathBuf>> {
     register_font();
     let mut written = Vec::new();
-    let models = results["models"].as_array().cloned().unwrap_or_default();
+    let models = &results.models;
     // The bunny when measured, otherwise the first model.
     if let Some(m) = models
         .iter()
-        .find(|m| m["name"].as_str() == Some("bunny.ply"))
+        .find(|m| m.name == "bunny.ply")
         .or_else(|| models.first())
     {
         let path = dir.join("indices.png");
         indices_chart(&path, m)?;
         written.push(path);
-        if m["figure6"]["rows"].is_array() {
+        if let Some(figure6) = &m.figure6 {
             for mode in ["immediate", "per_second"] {
                 let path = dir.join(format!("figure6_{mode}.png"));
-                figure6_chart(&path, m, mode)?;
+                figure6_chart(&path, &m.name, &figure6.rows, mode)?;
                 written.push(path);
             }
         }
     }
-    if let Some(rows) = results["scale"]["rows"].as_array() {
+    if let Some(scale) = &results.scale {
         let path = dir.join("scale.png");
-        scale_chart(&path, rows)?;
+        scale_chart(&path, &scale.rows)?;
         written.push(path);
     }
     Ok(written)
@@ -50,14 +50,14 @@ pub fn write_all(dir: &Path, results: &Value) -> Result<Vec<PathBuf>> {
 
 /// Indices per triangle against the share of triangles (log axis): MTS
 /// strips, meshoptimizer's strips of each level, the triangle list.
-fn indices_chart(path: &Path, model: &Value) -> Result<()> {
-    let levels = model["levels"].as_array().cloned().unwrap_or_default();
-    let series = |key: &str| -> Vec<(f64, f64)> {
-        levels
+fn indices_chart(path: &Path, model: &Model) -> Result<()> {
+    let series = |indices: fn(&Level) -> u64| -> Vec<(f64, f64)> {
+        model
+            .levels
             .iter()
-            .filter_map(|l| {
-                let t = l["triangles"].as_f64()?;
-                Some((l["share"].as_f64()? * 100.0, l[key].as_f64()? / t.max(1.0)))
+            .map(|l| {
+                let t = l.triangles as f64;
+                (l.share * 100.0, indices(l) as f64 / t.max(1.0))
             })
             .collect()
     };
@@ -65,10 +65,7 @@ fn indices_chart(path: &Path, model: &Value) -> Result<()> {
     root.fill(&WHITE).map_err(err)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
-            format!(
-                "Indices sent per triangle, {}",
-                model["name"].as_str().unwrap_or("?")
-            ),
+            format!("Indices sent per triangle, {}", model.name),
             (FONT, 22),
         )
         .margin(15)
@@ -84,16 +81,20 @@ fn indices_chart(path: &Path, model: &Value) -> Result<()> {
         .draw()
         .map_err(err)?;
     let lines = [
-        ("mts_indices", "MTS strips (restart values included)", BLUE),
         (
-            "meshopt_strip_indices",
+            (|l: &Level| l.mts_indices) as fn(&Level) -> u64,
+            "MTS strips (restart values included)",
+            BLUE,
+        ),
+        (
+            |l: &Level| l.meshopt_strip_indices,
             "meshoptimizer strips of each level",
             RED,
         ),
-        ("list_indices", "triangle list", BLACK),
+        (|l: &Level| l.list_indices, "triangle list", BLACK),
     ]
     .into_iter()
-    .map(|(key, label, color)| (label, color, series(key)))
+    .map(|(indices, label, color)| (label, color, series(indices)))
     .collect();
     draw_lines(&mut chart, lines, SeriesLabelPosition::MiddleRight)?;
     root.present().map_err(err)?;
@@ -102,18 +103,16 @@ fn indices_chart(path: &Path, model: &Value) -> Result<()> {
 
 /// Build milliseconds, model megabytes and LoD-0 extraction microseconds
 /// against triangles, log-log.
-fn scale_chart(path: &Path, rows: &[Value]) -> Result<()> {
-    let get = |key: &str, scale: f64| -> Vec<(f64, f64)> {
+fn scale_chart(path: &Path, rows: &[ScaleRow]) -> Result<()> {
+    let build = |r: &ScaleRow| r.build_ms;
+    let bytes = |r: &ScaleRow| r.model_bytes as f64;
+    let extract = |r: &ScaleRow| r.extract_lod0_us;
+    let get = |value: fn(&ScaleRow) -> f64, scale: f64| -> Vec<(f64, f64)> {
         rows.iter()
-            .filter_map(|r| Some((r["triangles"].as_f64()?, r[key].as_f64()? * scale)))
+            .map(|r| (r.triangles as f64, value(r) * scale))
             .collect()
     };
-    let all: Vec<(f64, f64)> = [
-        get("build_ms", 1.0),
-        get("model_bytes", 1e-6),
-        get("extract_lod0_us", 1.0),
-    ]
-    .concat();
+    let all: Vec<(f64, f64)> = [get(build, 1.0), get(bytes, 1e-6), get(extract, 1.0)].concat();
     let (x0, x1) = all
         .iter()
         .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
@@ -142,12 +141,12 @@ fn scale_chart(path: &Path, rows: &[Value]) -> Result<()> {
         .draw()
         .map_err(err)?;
     let lines = [
-        ("build_ms", 1.0, "build (ms)", BLUE),
-        ("model_bytes", 1e-6, "model in memory (MB)", RED),
-        ("extract_lod0_us", 1.0, "LoD 0 extraction (us)", GREEN),
+        (build as fn(&ScaleRow) -> f64, 1.0, "build (ms)", BLUE),
+        (bytes, 1e-6, "model in memory (MB)", RED),
+        (extract, 1.0, "LoD 0 extraction (us)", GREEN),
     ]
     .into_iter()
-    .map(|(key, scale, label, color)| (label, color, get(key, scale)))
+    .map(|(value, scale, label, color)| (label, color, get(value, scale)))
     .collect();
     draw_lines(&mut chart, lines, SeriesLabelPosition::UpperLeft)?;
     root.present().map_err(err)?;
@@ -157,21 +156,17 @@ fn scale_chart(path: &Path, rows: &[Value]) -> Result<()> {
 /// Frames per second against the share of triangles (log axis), one line
 /// per method, for one mode: the MTS paper's Figure 6 (up: `immediate`,
 /// down: `per_second`).
-fn figure6_chart(path: &Path, model: &Value, mode: &str) -> Result<()> {
-    let rows = model["figure6"]["rows"]
-        .as_array()
-        .cloned()
-        .unwrap_or_default();
+fn figure6_chart(path: &Path, name: &str, rows: &[Figure6Row], mode: &str) -> Result<()> {
     let series = |method: &str| -> Vec<(f64, f64)> {
         rows.iter()
-            .filter(|r| r["method"] == method && r["mode"] == mode)
-            .filter_map(|r| Some((r["share"].as_f64()? * 100.0, r["fps"].as_f64()?)))
+            .filter(|r| r.method == method && r.mode == mode)
+            .map(|r| (r.share * 100.0, r.fps))
             .collect()
     };
     let top = rows
         .iter()
-        .filter(|r| r["mode"] == mode)
-        .filter_map(|r| r["fps"].as_f64())
+        .filter(|r| r.mode == mode)
+        .map(|r| r.fps)
         .fold(1.0f64, f64::max);
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
@@ -179,7 +174,7 @@ fn figure6_chart(path: &Path, model: &Value, mode: &str) -> Result<()> {
         .caption(
             format!(
                 "Frames per second, {}, {}",
-                model["name"].as_str().unwrap_or("?"),
+                name,
                 if mode == "immediate" {
                     "extract + draw each frame"
                 } else {
@@ -250,4 +245,28 @@ where
         .draw()
         .map_err(err)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The charts drawn from the committed report's data are the committed
+    /// PNGs, byte for byte.
+    #[test]
+    fn charts_of_the_committed_report_are_its_pngs() {
+        let report = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/report"));
+        let results = Results::load(&report.join("results.json")).unwrap();
+        let dir = std::env::temp_dir().join(format!("mts-charts-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let written = write_all(&dir, &results).unwrap();
+        assert_eq!(written.len(), 4);
+        for path in &written {
+            let name = path.file_name().unwrap();
+            let ours = std::fs::read(path).unwrap();
+            let committed = std::fs::read(report.join(name)).unwrap();
+            assert!(ours == committed, "{name:?} differs from the committed chart");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }
