@@ -1028,4 +1028,27 @@ mod tests {
         assert!((k - 1.25).abs() < 1e-9, "{k}");
         assert_eq!(growth_exponent(&points[..1]), None);
     }
+
+    /// The report written from the committed results.json is the committed
+    /// report.md, byte for byte.
+    #[test]
+    fn the_committed_report_is_what_its_data_gives() {
+        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/report"));
+        let results = crate::results::Results::load(&dir.join("results.json")).unwrap();
+        let mut text = report(&results.to_value());
+        let _ = writeln!(text, "\n## Charts\n");
+        for name in [
+            "indices",
+            "figure6_immediate",
+            "figure6_per_second",
+            "scale",
+        ] {
+            let _ = writeln!(text, "![{name}.png]({name}.png)\n");
+        }
+        let committed = std::fs::read_to_string(dir.join("report.md")).unwrap();
+        assert!(
+            text == committed,
+            "report.md differs from what results.json gives"
+        );
+    }
 }

@@ -265,7 +265,10 @@ mod tests {
             let name = path.file_name().unwrap();
             let ours = std::fs::read(path).unwrap();
             let committed = std::fs::read(report.join(name)).unwrap();
-            assert!(ours == committed, "{name:?} differs from the committed chart");
+            assert!(
+                ours == committed,
+                "{name:?} differs from the committed chart"
+            );
         }
         std::fs::remove_dir_all(&dir).ok();
     }
