@@ -5,6 +5,7 @@
 //! compared with. Timings are medians of a few repetitions; the machine
 //! section names the CPU they come from.
 
+use crate::results::{Figure6Row, Model, Results, Scale};
 use anyhow::{Context, Result};
 use mts::distance::{surface_distance, Surface};
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
@@ -589,107 +590,101 @@ pub fn f(v: &Value) -> f64 {
 }
 
 /// The immediate-mode Figure 6 row of `method` at the share of `at`
-/// (`null` when not measured).
-pub fn figure6_row(rows: &[Value], at: &Value, method: &str) -> Value {
+/// (`None` when not measured).
+pub fn figure6_row<'r>(
+    rows: &'r [Figure6Row],
+    at: &Figure6Row,
+    method: &str,
+) -> Option<&'r Figure6Row> {
     rows.iter()
-        .find(|y| y["share"] == at["share"] && y["method"] == method && y["mode"] == "immediate")
-        .cloned()
-        .unwrap_or(Value::Null)
+        .find(|y| y.share == at.share && y.method == method && y.mode == "immediate")
 }
 
 /// The scale section's table and fitted exponents (the report's and the
 /// README's).
-pub fn scale_table(s: &mut String, results: &Value) {
-    let rows = results["scale"]["rows"]
-        .as_array()
-        .cloned()
-        .unwrap_or_default();
+pub fn scale_table(s: &mut String, scale: &Scale) {
     let _ = writeln!(s, "Stripify and simplify (whole sequence) each timed alone, beside meshoptimizer's `stripify` and `simplify` to 10%; build is the whole pipeline (stripify beside simplify, then the model).\n");
     let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes | peak RSS bytes (process so far) | LoD 0 extraction µs |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|");
-    for r in &rows {
+    for r in &scale.rows {
         let _ = writeln!(
             s,
             "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} | {} | {:.0} |",
-            r["triangles"],
-            f(&r["stripify_ms"]),
-            f(&r["meshopt_stripify_ms"]),
-            f(&r["simplify_ms"]),
-            f(&r["meshopt_simplify_to_10_ms"]),
-            f(&r["build_ms"]),
-            r["model_bytes"],
-            r["peak_rss_bytes"],
-            f(&r["extract_lod0_us"]),
+            r.triangles,
+            r.stripify_ms,
+            r.meshopt_stripify_ms,
+            r.simplify_ms,
+            r.meshopt_simplify_to_10_ms,
+            r.build_ms,
+            r.model_bytes,
+            r.peak_rss_bytes,
+            r.extract_lod0_us,
         );
     }
-    let e = &results["scale"]["exponent"];
+    let e = &scale.exponent;
     let _ = writeln!(
         s,
         "\nFitted growth exponents (y ~ triangles^k): stripify {:.2} (meshoptimizer {:.2}), simplify {:.2} (meshoptimizer to 10% {:.2}), build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.",
-        f(&e["stripify_ms"]),
-        f(&e["meshopt_stripify_ms"]),
-        f(&e["simplify_ms"]),
-        f(&e["meshopt_simplify_to_10_ms"]),
-        f(&e["build_ms"]),
-        f(&e["model_bytes"]),
-        f(&e["extract_lod0_us"]),
+        e.stripify_ms,
+        e.meshopt_stripify_ms,
+        e.simplify_ms,
+        e.meshopt_simplify_to_10_ms,
+        e.build_ms,
+        e.model_bytes,
+        e.extract_lod0_us,
     );
 }
 
 /// The per-model strips table (the report's and the README's): the
 /// project's strips against meshoptimizer's on each input mesh.
-pub fn strips_table(s: &mut String, models: &[Value]) {
+pub fn strips_table(s: &mut String, models: &[Model]) {
     let _ = writeln!(
         s, "The project's stripifier (adjacency included) against meshoptimizer's `optimize_vertex_cache_strip` + `stripify` on the input mesh, restart encoding; medians of interleaved runs. Each cell: mts / meshopt.\n");
     let _ = writeln!(
         s, "| model | triangles | strips | swaps | indices (restart) | indices per triangle | ACMR | ms |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
     for r in models {
-        let (a, b) = (&r["stripify"], &r["stripify"]["meshopt"]);
+        let (a, b) = (&r.stripify.mts, &r.stripify.meshopt);
         let _ = writeln!(
             s,
             "| {} | {} | {} / {} | {} / {} | {} / {} | {:.4} / {:.4} | {:.3} / {:.3} | {:.1} / {:.1} |",
-            r["name"].as_str().unwrap_or("?"),
-            a["triangles"],
-            a["strips"],
-            b["strips"],
-            a["swaps"],
-            b["swaps"],
-            a["indices_restart"],
-            b["indices_restart"],
-            f(&a["indices_per_triangle"]),
-            f(&b["indices_per_triangle"]),
-            f(&a["acmr"]),
-            f(&b["acmr"]),
-            f(&a["ms"]),
-            f(&b["ms"]),
+            r.name,
+            a.triangles,
+            a.strips,
+            b.strips,
+            a.swaps,
+            b.swaps,
+            a.indices_restart,
+            b.indices_restart,
+            a.indices_per_triangle,
+            b.indices_per_triangle,
+            a.acmr,
+            b.acmr,
+            a.ms,
+            b.ms,
         );
     }
 }
 
 /// "CPU (N cores), OS" and the graphics adapter (or why there is none),
 /// for the report's and the README's first lines.
-pub fn machine_words(results: &Value) -> (String, String) {
-    let m = &results["machine"];
+pub fn machine_words(results: &Results) -> (String, String) {
+    let m = &results.machine;
     (
-        format!(
-            "{} ({} cores), {}",
-            m["cpu"].as_str().unwrap_or("?"),
-            m["cores"],
-            m["os"].as_str().unwrap_or("?")
-        ),
-        m["adapter"]
-            .as_str()
-            .or(m["adapter_note"].as_str())
+        format!("{} ({} cores), {}", m.cpu, m.cores, m.os),
+        m.adapter
+            .as_deref()
+            .or(m.adapter_note.as_deref())
             .unwrap_or("none")
             .to_string(),
     )
 }
 
 /// `report.md` from the results.
-pub fn report(results: &Value) -> String {
+pub fn report(typed: &Results) -> String {
+    let results = &typed.to_value();
     let mut s = String::new();
-    let (machine, adapter) = machine_words(results);
+    let (machine, adapter) = machine_words(typed);
     let _ = writeln!(s, "# mts bench report\n");
     let _ = writeln!(
         s,
@@ -727,7 +722,7 @@ pub fn report(results: &Value) -> String {
         );
     }
     let _ = writeln!(s, "\n## Strips against meshoptimizer\n");
-    strips_table(&mut s, &models);
+    strips_table(&mut s, &typed.models);
     let _ = writeln!(s, "\n### Table 1, every method: bytes and build time\n");
     let _ = writeln!(s, "File bytes against the raw mesh with 16-bit indices (12 per vertex + 6 per triangle, the cluster-tree paper's reference). MTS builds the whole pipeline; the baselines start from the mesh and MTS's contraction sequence (the cluster tree makes its own clustering). Multilevel has no file format of its own: its figure is the in-memory structure.\n");
     let _ = writeln!(
@@ -929,32 +924,33 @@ pub fn report(results: &Value) -> String {
             }
         }
     }
-    if models.iter().any(|r| r["figure6"].is_object()) {
+    if typed.models.iter().any(|r| r.figure6.is_some()) {
         let _ = writeln!(s, "\n### Figure 6, draw time per frame\n");
         let _ = writeln!(s, "The same runs: the median time of one frame drawn without a LoD change (submit and wait), MTS strips against the meshoptimizer-ordered list, and the median time of one MTS LoD change (extraction and dirty-range upload, one LoD step back and forth).\n");
         let _ = writeln!(s, "| model | share | triangles | indices mts / list | draw ms mts / list | Mtri/s mts / list | MTS LoD change µs |");
         let _ = writeln!(s, "|---|---|---|---|---|---|---|");
-        for r in &models {
-            let rows = r["figure6"]["rows"].as_array().cloned().unwrap_or_default();
+        for r in &typed.models {
+            let rows = r.figure6.as_ref().map_or(&[][..], |f| &f.rows[..]);
             for x in rows
                 .iter()
-                .filter(|x| x["method"] == "mts" && x["mode"] == "immediate")
+                .filter(|x| x.method == "mts" && x.mode == "immediate")
             {
-                let list = figure6_row(&rows, x, "list");
-                let tri = f(&x["triangles"]);
+                let list = figure6_row(rows, x, "list");
+                let list_ms = list.map_or(f64::NAN, |l| l.draw_ms);
+                let tri = x.triangles as f64;
                 let _ = writeln!(
                     s,
                     "| {} | {:.0}% | {} | {} / {} | {:.2} / {:.2} | {:.2} / {:.2} | {:.0} |",
-                    r["name"].as_str().unwrap_or("?"),
-                    f(&x["share"]) * 100.0,
-                    x["triangles"],
-                    x["indices_sent"],
-                    list["indices_sent"],
-                    f(&x["draw_ms"]),
-                    f(&list["draw_ms"]),
-                    tri / f(&x["draw_ms"]) / 1e3,
-                    tri / f(&list["draw_ms"]) / 1e3,
-                    f(&x["change_us"]),
+                    r.name,
+                    x.share * 100.0,
+                    x.triangles,
+                    x.indices_sent,
+                    list.map_or_else(|| "null".to_string(), |l| l.indices_sent.to_string()),
+                    x.draw_ms,
+                    list_ms,
+                    tri / x.draw_ms / 1e3,
+                    tri / list_ms / 1e3,
+                    x.change_us.unwrap_or(f64::NAN),
                 );
             }
         }
@@ -980,9 +976,9 @@ pub fn report(results: &Value) -> String {
             f(&scene["triangles_per_second"]) / 1e6,
         );
     }
-    if results["scale"]["rows"].is_array() {
+    if let Some(scale) = &typed.scale {
         let _ = writeln!(s, "\n## Scale: generated icospheres\n");
-        scale_table(&mut s, results);
+        scale_table(&mut s, scale);
     }
     s
 }
@@ -993,13 +989,12 @@ pub fn report(results: &Value) -> String {
 /// NaN it produced, stops here with the key named.
 pub fn write(dir: &Path, results: &Value) -> Result<()> {
     let typed = crate::results::Results::from_value(results.clone())?;
-    let results = &typed.to_value();
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let json_path = dir.join("results.json");
     std::fs::write(&json_path, serde_json::to_string_pretty(&typed)?)
         .with_context(|| format!("cannot write {}", json_path.display()))?;
     let charts = super::charts::write_all(dir, &typed)?;
-    let mut text = report(results);
+    let mut text = report(&typed);
     if !charts.is_empty() {
         let _ = writeln!(text, "\n## Charts\n");
         for c in &charts {
@@ -1035,7 +1030,7 @@ mod tests {
     fn the_committed_report_is_what_its_data_gives() {
         let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/report"));
         let results = crate::results::Results::load(&dir.join("results.json")).unwrap();
-        let mut text = report(&results.to_value());
+        let mut text = report(&results);
         let _ = writeln!(text, "\n## Charts\n");
         for name in [
             "indices",
@@ -1046,9 +1041,16 @@ mod tests {
             let _ = writeln!(text, "![{name}.png]({name}.png)\n");
         }
         let committed = std::fs::read_to_string(dir.join("report.md")).unwrap();
+        let first = text
+            .lines()
+            .zip(committed.lines())
+            .position(|(a, b)| a != b);
         assert!(
             text == committed,
-            "report.md differs from what results.json gives"
+            "report.md differs from what results.json gives, first at line {:?}:\n{:?}\n{:?}",
+            first.map(|i| i + 1),
+            first.and_then(|i| text.lines().nth(i)),
+            first.and_then(|i| committed.lines().nth(i)),
         );
     }
 }

@@ -153,7 +153,7 @@ struct SummaryArgs {
 
 fn bench_summary(args: &SummaryArgs) -> Result<()> {
     let path = &args.results;
-    let results = results::Results::load(path)?.to_value();
+    let results = results::Results::load(path)?;
     let Some(readme) = &args.readme else {
         let dir = path
             .parent()
