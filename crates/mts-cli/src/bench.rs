@@ -5,7 +5,7 @@
 //! compared with. Timings are medians of a few repetitions; the machine
 //! section names the CPU they come from.
 
-use crate::results::{Figure6Row, Model, Results, Scale};
+use crate::results::{FastSimplificationRun, Figure6Row, MethodRow, Model, Results, Scale};
 use anyhow::{Context, Result};
 use mts::distance::{surface_distance, Surface};
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
@@ -584,11 +584,6 @@ const PAPER_TABLE_3: [(&str, &str, &str); 3] = [
     ("69.4K", "92K", "83K"),
 ];
 
-/// A JSON number, NaN when absent.
-pub fn f(v: &Value) -> f64 {
-    v.as_f64().unwrap_or(f64::NAN)
-}
-
 /// The immediate-mode Figure 6 row of `method` at the share of `at`
 /// (`None` when not measured).
 pub fn figure6_row<'r>(
@@ -681,48 +676,43 @@ pub fn machine_words(results: &Results) -> (String, String) {
 }
 
 /// `report.md` from the results.
-pub fn report(typed: &Results) -> String {
-    let results = &typed.to_value();
+pub fn report(results: &Results) -> String {
     let mut s = String::new();
-    let (machine, adapter) = machine_words(typed);
+    let (machine, adapter) = machine_words(results);
+    let models = &results.models;
     let _ = writeln!(s, "# mts bench report\n");
     let _ = writeln!(
         s,
-        "Command: `{}`{}. Machine: {machine}. Graphics adapter (Figure 6): {adapter}.\n",
-        results["command"].as_str().unwrap_or(""),
-        results["elapsed_s"]
-            .as_f64()
-            .map_or_else(String::new, |e| format!(", {e:.0} s")),
+        "Command: `{}`, {:.0} s. Machine: {machine}. Graphics adapter (Figure 6): {adapter}.\n",
+        results.command, results.elapsed_s,
     );
-    let models = results["models"].as_array().cloned().unwrap_or_default();
     let _ = writeln!(s, "## Table 1: models and sizes (bytes)\n");
     let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | MTS in memory | build ms (stripify ‖ simplify, model, total) |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for r in &models {
-        let b = &r["bytes"];
-        let t = &r["build_ms"];
+    for r in models {
+        let (b, t) = (&r.bytes, &r.build_ms);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
-            r["name"].as_str().unwrap_or("?"),
-            r["strips"],
-            r["triangles"],
-            r["vertices"],
-            f(&r["max_lod"]) as u64 + 1,
-            r["bands"],
-            b["raw"],
-            b["raw_u16"],
-            b["mts_file"],
-            f(&b["mts_file"]) / f(&b["raw"]),
-            b["mts_memory"],
-            f(&t["stripify"]),
-            f(&t["simplify"]),
-            f(&t["model"]),
-            f(&t["total"]),
+            r.name,
+            r.strips,
+            r.triangles,
+            r.vertices,
+            r.max_lod + 1,
+            r.bands,
+            b.raw,
+            b.raw_u16,
+            b.mts_file,
+            b.mts_file as f64 / b.raw as f64,
+            b.mts_memory,
+            t.stripify,
+            t.simplify,
+            t.model,
+            t.total,
         );
     }
     let _ = writeln!(s, "\n## Strips against meshoptimizer\n");
-    strips_table(&mut s, &typed.models);
+    strips_table(&mut s, models);
     let _ = writeln!(s, "\n### Table 1, every method: bytes and build time\n");
     let _ = writeln!(s, "File bytes against the raw mesh with 16-bit indices (12 per vertex + 6 per triangle, the cluster-tree paper's reference). MTS builds the whole pipeline; the baselines start from the mesh and MTS's contraction sequence (the cluster tree makes its own clustering). Multilevel has no file format of its own: its figure is the in-memory structure.\n");
     let _ = writeln!(
@@ -730,29 +720,35 @@ pub fn report(typed: &Results) -> String {
         "| model | method | file bytes | file / raw 16-bit | memory bytes | build ms |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|");
-    for r in &models {
-        for m in r["methods"].as_array().into_iter().flatten() {
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {:.3} | {} | {:.0} |",
-                r["name"].as_str().unwrap_or("?"),
-                m["method"].as_str().unwrap_or("?"),
-                m["file_bytes"],
-                f(&m["file_ratio_to_raw_u16"]),
-                m["memory_bytes"],
-                f(&m["build_ms"]),
-            );
+    for r in models {
+        for m in &r.methods {
+            let _ = match m {
+                MethodRow::Measured(m) => writeln!(
+                    s,
+                    "| {} | {} | {} | {:.3} | {} | {:.0} |",
+                    r.name,
+                    m.method,
+                    m.file_bytes,
+                    m.file_ratio_to_raw_u16,
+                    m.memory_bytes,
+                    m.build_ms,
+                ),
+                MethodRow::Skipped { method, skipped } => {
+                    writeln!(s, "| {} | {method} | skipped: {skipped} | | | |", r.name)
+                }
+            };
         }
     }
     let _ = writeln!(s, "\n## Table 2: microseconds per LoD change\n");
     let _ = writeln!(s, "Sequences of `mts::model::sequence` (linear: coarsest to finest in equal steps; exponential: triangle counts in geometric steps; random: uniform, seed 1); medians of five passes each, with and without coherence interleaved, each from a fresh extractor (its construction not timed).\n");
     let _ = writeln!(s, "| model | linear coherent | linear without | × | exponential coherent | exponential without | × | random coherent | random without | × |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
-    for r in &models {
-        let mut row = format!("| {} |", r["name"].as_str().unwrap_or("?"));
+    for r in models {
+        let mut row = format!("| {} |", r.name);
         for seq in ["linear", "exponential", "random"] {
-            let e = &r["extraction"][seq];
-            let (c, w) = (f(&e["mts_coherent_us"]), f(&e["mts_scratch_us"]));
+            let (c, w) = r.extraction.get(seq).map_or((f64::NAN, f64::NAN), |e| {
+                (e.mts_coherent_us, e.mts_scratch_us)
+            });
             let _ = write!(row, " {c:.1} | {w:.1} | {:.1} |", w / c);
         }
         let _ = writeln!(s, "{row}");
@@ -764,18 +760,20 @@ pub fn report(typed: &Results) -> String {
     let _ = writeln!(s, "Each method through `LodSource::set_lod` (MTS: the coherent extractor), the same sequences over its own LoD range, in one run. The cluster tree's LoDs are its own joins; discrete LoDs only switch buffers.\n");
     let _ = writeln!(s, "| model | method | linear | exponential | random |");
     let _ = writeln!(s, "|---|---|---|---|---|");
-    for r in &models {
-        for m in r["methods"].as_array().into_iter().flatten() {
-            let u = &m["us_per_change"];
-            let _ = writeln!(
-                s,
-                "| {} | {} | {:.1} | {:.1} | {:.1} |",
-                r["name"].as_str().unwrap_or("?"),
-                m["method"].as_str().unwrap_or("?"),
-                f(&u["linear"]),
-                f(&u["exponential"]),
-                f(&u["random"]),
-            );
+    for r in models {
+        for m in &r.methods {
+            if let MethodRow::Measured(m) = m {
+                let u = |seq: &str| m.us_per_change.get(seq).copied().unwrap_or(f64::NAN);
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {:.1} | {:.1} | {:.1} |",
+                    r.name,
+                    m.method,
+                    u("linear"),
+                    u("exponential"),
+                    u("random"),
+                );
+            }
         }
     }
     let _ = writeln!(
@@ -785,22 +783,22 @@ pub fn report(typed: &Results) -> String {
     let _ = writeln!(s, "MTS strips with restart values, the triangle list (`optimize_vertex_cache` order) and meshoptimizer's strips of that level's mesh (`optimize_vertex_cache_strip` + `stripify`), measured on the same LoD.\n");
     let _ = writeln!(s, "| model | share | triangles | MTS indices | list indices | meshopt strip indices | MTS / meshopt | ACMR MTS / list / meshopt strips | extract µs (from scratch) |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
-    for r in &models {
-        for l in r["levels"].as_array().into_iter().flatten() {
+    for r in models {
+        for l in &r.levels {
             let _ = writeln!(
                 s,
                 "| {} | {:.0}% | {} | {} | {} | {} | {:.3} | {:.3} / {:.3} / {:.3} | {:.1} |",
-                r["name"].as_str().unwrap_or("?"),
-                f(&l["share"]) * 100.0,
-                l["triangles"],
-                l["mts_indices"],
-                l["list_indices"],
-                l["meshopt_strip_indices"],
-                f(&l["mts_indices"]) / f(&l["meshopt_strip_indices"]),
-                f(&l["mts_acmr"]),
-                f(&l["list_acmr"]),
-                f(&l["meshopt_strip_acmr"]),
-                f(&l["extract_us"]),
+                r.name,
+                l.share * 100.0,
+                l.triangles,
+                l.mts_indices,
+                l.list_indices,
+                l.meshopt_strip_indices,
+                l.mts_indices as f64 / l.meshopt_strip_indices as f64,
+                l.mts_acmr,
+                l.list_acmr,
+                l.meshopt_strip_acmr,
+                l.extract_us,
             );
         }
     }
@@ -813,63 +811,54 @@ pub fn report(typed: &Results) -> String {
         "\n\n## Quality: simplification error against meshoptimizer\n"
     );
     let _ = writeln!(s, "Hausdorff and RMS distance to the input relative to its bounding-box diagonal ({SAMPLES} samples per side), meshoptimizer's `simplify` asked for the same triangle count (where it stops above it, the project's LoD is taken at its count).\n");
-    let peer = results["fast_simplification"].as_array();
-    if let Some(why) = results["fast_simplification"]["skipped"].as_str() {
-        let _ = writeln!(s, "fast-simplification not measured: {why}.\n");
-    }
+    let peer = match &results.fast_simplification {
+        Some(FastSimplificationRun::Rows(rows)) => Some(rows),
+        Some(FastSimplificationRun::Skipped { skipped }) => {
+            let _ = writeln!(s, "fast-simplification not measured: {skipped}.\n");
+            None
+        }
+        None => None,
+    };
     let _ = writeln!(s, "Speed: the project's whole contraction sequence (every LoD, default options) against meshoptimizer's `simplify` to 10% and to 1%, medians of interleaved runs in milliseconds.\n");
     let _ = writeln!(s, "| model | triangles | contractions | mts whole sequence | meshopt to 10% | meshopt to 1% | stopped |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|");
-    for r in &models {
-        let x = &r["simplify"];
+    for r in models {
+        let x = &r.simplify;
         let _ = writeln!(
             s,
             "| {} | {} | {} | {:.1} | {:.1} | {:.1} | {} |",
-            r["name"].as_str().unwrap_or("?"),
-            r["triangles"],
-            x["max_lod"],
-            f(&x["ms"]),
-            f(&x["meshopt_ms_to_10"]),
-            f(&x["meshopt_ms_to_1"]),
-            x["stop"].as_str().unwrap_or("?"),
+            r.name, r.triangles, x.max_lod, x.ms, x.meshopt_ms_to_10, x.meshopt_ms_to_1, x.stop,
         );
     }
     let _ = writeln!(s);
     let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts | Hausdorff meshopt | ratio | RMS mts | RMS meshopt | fast-simplification triangles, Hausdorff, RMS |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
-    for r in &models {
-        for q in r["quality"].as_array().into_iter().flatten() {
+    for r in models {
+        for q in &r.quality {
             let fast = peer
                 .into_iter()
                 .flatten()
-                .find(|p| p["mesh"] == r["name"] && p["ratio"].as_f64() == q["share"].as_f64())
+                .find(|p| p.mesh == r.name && p.ratio == q.share)
                 .map_or_else(
                     || "—".to_string(),
-                    |p| {
-                        format!(
-                            "{}, {:.5}, {:.5}",
-                            p["triangles"],
-                            f(&p["hausdorff"]),
-                            f(&p["rms"])
-                        )
-                    },
+                    |p| format!("{}, {:.5}, {:.5}", p.triangles, p.hausdorff, p.rms),
                 );
             let _ = writeln!(
                 s,
                 "| {} | {:.0}% | {} / {} | {:.5} | {:.5} | {:.2} | {:.5} | {:.5} | {fast} |",
-                r["name"].as_str().unwrap_or("?"),
-                f(&q["share"]) * 100.0,
-                q["mts"]["triangles"],
-                q["meshopt"]["triangles"],
-                f(&q["mts"]["hausdorff"]),
-                f(&q["meshopt"]["hausdorff"]),
-                f(&q["mts"]["hausdorff"]) / f(&q["meshopt"]["hausdorff"]),
-                f(&q["mts"]["rms"]),
-                f(&q["meshopt"]["rms"]),
+                r.name,
+                q.share * 100.0,
+                q.mts.triangles,
+                q.meshopt.triangles,
+                q.mts.hausdorff,
+                q.meshopt.hausdorff,
+                q.mts.hausdorff / q.meshopt.hausdorff,
+                q.mts.rms,
+                q.meshopt.rms,
             );
         }
     }
-    if models.iter().any(|r| r["figure6"].is_object()) {
+    if models.iter().any(|r| r.figure6.is_some()) {
         let _ = writeln!(
             s,
             "\n## Figure 6: frames per second against the share of triangles\n"
@@ -881,37 +870,31 @@ pub fn report(typed: &Results) -> String {
             "| model | share | triangles | mts | list | pm | multilevel | cluster | discrete |"
         );
         let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
-        for r in &models {
-            let rows = r["figure6"]["rows"].as_array().cloned().unwrap_or_default();
+        for r in models {
+            let rows = r.figure6.as_ref().map_or(&[][..], |f| &f.rows[..]);
             let mut shares: Vec<f64> = Vec::new();
-            for x in &rows {
-                if let Some(v) = x["share"].as_f64() {
-                    if !shares.contains(&v) {
-                        shares.push(v);
-                    }
+            for x in rows {
+                if !shares.contains(&x.share) {
+                    shares.push(x.share);
                 }
             }
             for share in shares {
                 let cell = |method: &str| {
                     let fps = |mode: &str| {
                         rows.iter()
-                            .find(|x| {
-                                x["share"].as_f64() == Some(share)
-                                    && x["method"] == method
-                                    && x["mode"] == mode
-                            })
-                            .map_or(f64::NAN, |x| f(&x["fps"]))
+                            .find(|x| x.share == share && x.method == method && x.mode == mode)
+                            .map_or(f64::NAN, |x| x.fps)
                     };
                     format!("{:.1} / {:.1}", fps("immediate"), fps("per_second"))
                 };
                 let triangles = rows
                     .iter()
-                    .find(|x| x["share"].as_f64() == Some(share) && x["method"] == "mts")
-                    .map_or(Value::Null, |x| x["triangles"].clone());
+                    .find(|x| x.share == share && x.method == "mts")
+                    .map_or_else(|| "null".to_string(), |x| x.triangles.to_string());
                 let _ = writeln!(
                     s,
                     "| {} | {:.0}% | {} | {} | {} | {} | {} | {} | {} |",
-                    r["name"].as_str().unwrap_or("?"),
+                    r.name,
                     share * 100.0,
                     triangles,
                     cell("mts"),
@@ -924,12 +907,12 @@ pub fn report(typed: &Results) -> String {
             }
         }
     }
-    if typed.models.iter().any(|r| r.figure6.is_some()) {
+    if models.iter().any(|r| r.figure6.is_some()) {
         let _ = writeln!(s, "\n### Figure 6, draw time per frame\n");
         let _ = writeln!(s, "The same runs: the median time of one frame drawn without a LoD change (submit and wait), MTS strips against the meshoptimizer-ordered list, and the median time of one MTS LoD change (extraction and dirty-range upload, one LoD step back and forth).\n");
         let _ = writeln!(s, "| model | share | triangles | indices mts / list | draw ms mts / list | Mtri/s mts / list | MTS LoD change µs |");
         let _ = writeln!(s, "|---|---|---|---|---|---|---|");
-        for r in &typed.models {
+        for r in models {
             let rows = r.figure6.as_ref().map_or(&[][..], |f| &f.rows[..]);
             for x in rows
                 .iter()
@@ -955,8 +938,7 @@ pub fn report(typed: &Results) -> String {
             }
         }
     }
-    let scene = &results["scene"];
-    if scene.is_object() {
+    if let Some(scene) = &results.scene {
         let _ = writeln!(s, "\n## Scene: many instances, each with its own LoD\n");
         let _ = writeln!(s, "`mts bench render`'s scene row on Figure 6's adapter: instances on a ground plane seen by the overview camera, culled by the instance BVH, each given the finest LoD with at most one triangle per 4 projected pixels and its own coherence cache. Frame: every instance's update and the draw, median.\n");
         let _ = writeln!(s, "| model | instances | visible | triangles | indices sent | CPU bytes per instance | first update ms | ms per frame | fps | Mtri/s |");
@@ -964,19 +946,19 @@ pub fn report(typed: &Results) -> String {
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.2} |",
-            scene["model"].as_str().unwrap_or("?"),
-            scene["instances"],
-            scene["visible"],
-            scene["triangles"],
-            scene["indices_sent"],
-            scene["cpu_bytes_per_instance"],
-            f(&scene["ms_first_update"]),
-            f(&scene["ms_per_frame"]),
-            f(&scene["fps"]),
-            f(&scene["triangles_per_second"]) / 1e6,
+            scene.model,
+            scene.instances,
+            scene.visible,
+            scene.triangles,
+            scene.indices_sent,
+            scene.cpu_bytes_per_instance,
+            scene.ms_first_update,
+            scene.ms_per_frame,
+            scene.fps,
+            scene.triangles_per_second / 1e6,
         );
     }
-    if let Some(scale) = &typed.scale {
+    if let Some(scale) = &results.scale {
         let _ = writeln!(s, "\n## Scale: generated icospheres\n");
         scale_table(&mut s, scale);
     }
