@@ -198,7 +198,8 @@ struct Contractor {
     /// Input positions as loaded (`f32`, half the cache footprint; widened
     /// exactly on use, see [`Contractor::p`]).
     pos: Vec<Vec3>,
-    /// Positions of the vertices optimal mode appends (`f64`, after `pos`).
+    /// Positions of the vertices optimal mode appends (`f64`, after `pos`;
+    /// rounded to `f32` once, for the output, in [`Contractor::finish`]).
     appended_pos: Vec<DVec3>,
     quadrics: Vec<Quadric>,
     /// The input positions each vertex stands for (its own and those
@@ -259,7 +260,6 @@ struct Contractor {
     /// Output.
     steps: Vec<Collapse>,
     triangle_counts: Vec<u32>,
-    appended: Vec<Vec3>,
     triangles_now: u32,
     max_error: f32,
     stop: Option<Stop>,
@@ -401,7 +401,6 @@ impl Contractor {
             around: Vec::new(),
             steps: Vec::new(),
             triangle_counts: vec![triangles_now],
-            appended: Vec::new(),
             triangles_now,
             max_error: 0.0,
             stop: None,
@@ -577,7 +576,6 @@ impl Contractor {
                 if !self.partners.is_empty() {
                     self.partners.push(Vec::new());
                 }
-                self.appended.push(target.as_vec3());
                 c
             }
         };
@@ -735,7 +733,7 @@ impl Contractor {
             self.input_vertices,
             self.steps,
             self.triangle_counts,
-            self.appended,
+            self.appended_pos.iter().map(|p| p.as_vec3()).collect(),
         );
         Simplification { collapses, stop }
     }
