@@ -9,8 +9,8 @@ median of --repeat runs), hausdorff and rms (relative to the input's
 bounding-box diagonal, measured by `mts distance` exactly as `mts simplify`
 measures itself).
 
-    python3 benches/peers/fast_simplification.py ../shared/models/bunny.ply
-    python3 benches/peers/fast_simplification.py --ratios 0.1,0.01 MESH...
+    python3 crates/mts-cli/peers/fast_simplification.py ../shared/models/bunny.ply
+    python3 crates/mts-cli/peers/fast_simplification.py --ratios 0.1,0.01 MESH...
 """
 
 import argparse

@@ -9,7 +9,7 @@
 //! Hausdorff distance is more than 15% above the previous line's. All
 //! distances are relative to the input's bounding-box diagonal.
 //!
-//! Run with `cargo run --release --example lod_trace -- MESH FROM TO
+//! Run with `cargo run --release -p mts --example lod_trace -- MESH FROM TO
 //! [EVERY]`, e.g. `… -- ../shared/models/beetle.obj 900 200` (triangle
 //! counts; every `EVERY`-th LoD, default 1).
 
