@@ -85,6 +85,12 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
             || path.display().to_string(),
             |n| n.to_string_lossy().into(),
         );
+        // Every section compares with meshoptimizer: a mesh where its time
+        // is quadratic is left out, as every other command does.
+        if let Some(why) = peers::meshopt::refusal(&mesh) {
+            progress(&format!("{name} skipped: {why}"));
+            continue;
+        }
         inputs.push((name, mesh));
     }
     let requests = if options.quick {

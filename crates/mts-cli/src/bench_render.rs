@@ -35,9 +35,9 @@ pub struct BenchRenderArgs {
     json: bool,
 }
 
-/// The scene row refuses to hold more than this many bytes of per-instance
-/// coherence caches (4 bytes per slot index per instance).
-const SCENE_MEMORY_CAP: usize = 2 << 30;
+/// The scene row skips (with a note) where the scene itself would refuse:
+/// past this many bytes of per-instance coherence caches.
+use mts_render::scene::MAX_CACHE_BYTES as SCENE_MEMORY_CAP;
 
 /// Median milliseconds of `frames` frames of `renderer` into `target`.
 fn frame_ms(

@@ -145,6 +145,7 @@ pub struct InstancedScene<'m> {
     visible: Vec<InstanceId>,
     scratch: Vec<u16>,
     stitch_scratch: Vec<u32>,
+    transform_scratch: Vec<f32>,
 }
 
 impl<'m> InstancedScene<'m> {
@@ -167,6 +168,7 @@ impl<'m> InstancedScene<'m> {
             visible: Vec::new(),
             scratch: Vec::new(),
             stitch_scratch: Vec::new(),
+            transform_scratch: Vec::new(),
         }
     }
 
@@ -387,17 +389,7 @@ impl<'m> InstancedScene<'m> {
         for entry in &mut self.models {
             entry.renderer.set_camera(queue, camera);
             grow(device, entry)?;
-            for &i in &entry.moved {
-                if let Some(slot) = &entry.slots[i as usize] {
-                    let m = slot.transform.to_cols_array();
-                    queue.write_buffer(
-                        &entry.instance_buffer,
-                        u64::from(i) * INSTANCE_BYTES,
-                        bytemuck::cast_slice(&m),
-                    );
-                }
-            }
-            entry.moved.clear();
+            upload_transforms(queue, entry, &mut self.transform_scratch);
         }
         if self.dirty {
             self.rebuild_bvh();
@@ -614,6 +606,36 @@ fn buffers(
         mapped_at_creation: false,
     });
     Ok((index_buffer, instance_buffer))
+}
+
+/// Uploads the transforms of `entry`'s moved slots: each run of
+/// consecutive slots in one write (a host moving every instance each frame
+/// sends one buffer, not one write per instance), each slot once however
+/// often it moved. Clears the list.
+fn upload_transforms(queue: &wgpu::Queue, entry: &mut ModelEntry<'_>, scratch: &mut Vec<f32>) {
+    let moved = &mut entry.moved;
+    moved.sort_unstable();
+    moved.dedup();
+    let mut i = 0;
+    while i < moved.len() {
+        let first = moved[i];
+        scratch.clear();
+        let mut next = first;
+        while i < moved.len() && moved[i] == next {
+            let m = entry.slots[next as usize]
+                .as_ref()
+                .map_or(Mat4::ZERO, |slot| slot.transform);
+            scratch.extend_from_slice(&m.to_cols_array());
+            next += 1;
+            i += 1;
+        }
+        queue.write_buffer(
+            &entry.instance_buffer,
+            u64::from(first) * INSTANCE_BYTES,
+            bytemuck::cast_slice(scratch),
+        );
+    }
+    moved.clear();
 }
 
 /// Grows `entry`'s buffers to hold all its slots (doubling); after a

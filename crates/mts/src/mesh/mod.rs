@@ -119,6 +119,17 @@ pub fn power_of_two_scale(positions: &[Vec3]) -> f64 {
     2f64.powi(-f64::from(largest).log2().floor() as i32)
 }
 
+/// `positions` times `scale` (a power of two from [`power_of_two_scale`]:
+/// exact, computed in `f64` so a factor beyond `f32`'s range still works).
+/// O(n).
+#[must_use]
+pub fn scaled_positions(positions: &[Vec3], scale: f64) -> Vec<Vec3> {
+    positions
+        .iter()
+        .map(|p| (p.as_dvec3() * scale).as_vec3())
+        .collect()
+}
+
 /// Length of the box `lo..hi` as [`Mesh::diagonal_f64`] defines it.
 #[must_use]
 pub fn diagonal_of(lo: Vec3, hi: Vec3) -> f64 {

@@ -72,12 +72,7 @@ impl ClusterTree {
         let joins = if scale == 1.0 {
             build::cluster(&mesh.positions)
         } else {
-            let scaled: Vec<_> = mesh
-                .positions
-                .iter()
-                .map(|&p| (p.as_dvec3() * scale).as_vec3())
-                .collect();
-            build::cluster(&scaled)
+            build::cluster(&crate::mesh::scaled_positions(&mesh.positions, scale))
         };
         let diagonal = mesh.diagonal_f64() * scale;
         let steps: Vec<_> = joins

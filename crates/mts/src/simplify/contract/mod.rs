@@ -111,11 +111,7 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     let scale = crate::mesh::power_of_two_scale(&mesh.positions);
     if scale != 1.0 {
         let scaled = Mesh {
-            positions: mesh
-                .positions
-                .iter()
-                .map(|p| (p.as_dvec3() * scale).as_vec3())
-                .collect(),
+            positions: crate::mesh::scaled_positions(&mesh.positions, scale),
             triangles: mesh.triangles.clone(),
         };
         let mut result = simplify(&scaled, options);
