@@ -1,29 +1,15 @@
 //! The PLY reader (ascii, binary little- and big-endian) on arbitrary
-//! bytes: an error or a raw mesh that cleans to a valid mesh (or to a clean
-//! error), never a panic; small accepted meshes are also stripified and the
-//! strips must draw exactly the mesh's triangles.
+//! bytes (see `loaded_mesh.rs` for what an accepted mesh must satisfy).
 #![no_main]
+
+#[path = "loaded_mesh.rs"]
+mod loaded_mesh;
 
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(raw) = mts::mesh::io::parse_ply(data, Path::new("fuzz.ply")) {
-        check(raw);
+        loaded_mesh::check(raw);
     }
 });
-
-fn check(raw: mts::mesh::RawMesh) {
-    let Ok((mesh, _report)) = mts::mesh::clean(raw, Default::default(), "fuzz") else {
-        return;
-    };
-    mesh.validate().unwrap();
-    if mesh.triangle_count() <= 2000 {
-        let strips = mts::stripify(&mesh, &Default::default());
-        assert_eq!(
-            mts::strip::sorted_canonical(&strips.triangles()),
-            mts::strip::sorted_canonical(&mesh.triangles),
-            "the strips do not draw exactly the mesh's triangles"
-        );
-    }
-}
