@@ -55,7 +55,7 @@ pub const NODE_MASK: u32 = RESTART - 1;
 /// A multiresolution triangle strip model: every strip's labelled graph, the
 /// vertices they index and the LoD → triangle count table.
 ///
-/// Invariants (checked by [`MtsModel::check`], which the loader runs):
+/// Invariants (checked by [`MtsModel::validate`], which the loader runs):
 /// offsets are non-decreasing and in range; every node's vertex is below the
 /// vertex count; every arc target is [`END`] or a later node of the same
 /// strip (optionally with [`RESTART`]); labels are at most `max_lod` and

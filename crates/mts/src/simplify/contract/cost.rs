@@ -1,22 +1,10 @@
 //! What a contraction costs and where the survivor goes: the quadric cost
 //! of moving a vertex onto another, the tie-break, and the optimal point
-//! (the one place placement is decided: [`Contractor::target_position`]).
+//! (which of them a contraction uses is the [`Place`] strategy's choice).
 
 use super::*;
 
-impl Contractor {
-    /// Cost of contracting `v` with `w`: moving `v` onto `w`, or in optimal
-    /// mode both onto the merged quadric's best point.
-    pub(super) fn pair_cost(&self, v: u32, w: u32) -> f64 {
-        match self.placement {
-            Placement::Endpoint => self.cost(v, w),
-            Placement::Optimal => {
-                let q = self.quadrics[v as usize] + self.quadrics[w as usize];
-                self.optimal_point(&q, v, w).1
-            }
-        }
-    }
-
+impl Contractor<Endpoint> {
     /// Cost of moving `removed` onto `kept` (endpoint placement): the mean
     /// squared distance from the kept position to the removed vertex's
     /// planes. Only the removed vertex's quadric counts, since the kept one
@@ -37,9 +25,11 @@ impl Contractor {
     pub(super) fn cost(&self, removed: u32, kept: u32) -> f64 {
         let p = self.p(kept);
         self.quadrics[removed as usize].mean_error(p)
-            + TIE_BREAK * self.anchors[removed as usize].mean_error(p)
+            + TIE_BREAK * self.place.anchors[removed as usize].mean_error(p)
     }
+}
 
+impl<P: Place> Contractor<P> {
     /// The quadric's minimiser, or the best of the endpoints and midpoint.
     pub(super) fn optimal_point(&self, q: &Quadric, a: u32, b: u32) -> (DVec3, f64) {
         let (pa, pb) = (self.p(a), self.p(b));
@@ -51,16 +41,5 @@ impl Contractor {
             }
         }
         best
-    }
-
-    /// Where the surviving vertex of `a → b` goes.
-    pub(super) fn target_position(&self, a: u32, b: u32) -> DVec3 {
-        match self.placement {
-            Placement::Endpoint => self.p(b),
-            Placement::Optimal => {
-                let q = self.quadrics[a as usize] + self.quadrics[b as usize];
-                self.optimal_point(&q, a, b).0
-            }
-        }
     }
 }

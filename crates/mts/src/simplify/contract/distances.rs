@@ -72,12 +72,12 @@ pub(super) fn over_within(triangles: &[Prism], p: DVec3, within: f64) -> bool {
         .any(|t| t.over(p).is_some_and(|d| d <= within))
 }
 
-impl Contractor {
+impl Contractor<Endpoint> {
     /// Squared distance from `a`'s input position to the nearest triangle
     /// of its fan once `a` is moved onto `b`, or of `b`'s when none of
     /// `a`'s survives (zero when neither has one); or, where larger than
     /// both that and `limit`, the largest squared distance from an input
-    /// vertex contracted into `a` earlier (its [`Contractor::members`]) to
+    /// vertex contracted into `a` earlier (its [`Endpoint::members`]) to
     /// `b`'s fan after the move.
     ///
     /// The quadric cost measures how far `b` lies from `a`'s planes, the
@@ -128,7 +128,7 @@ impl Contractor {
             self.nearest_around(pa, b, a, pb, 0.0)
         };
         let nearest = if nearest.is_finite() { nearest } else { 0.0 };
-        if self.members[a as usize].1 == a {
+        if self.place.members[a as usize].1 == a {
             return nearest;
         }
         // `b`'s fan after the move: `a`'s triangles without `b` (moved),
@@ -142,10 +142,10 @@ impl Contractor {
         let moved = after.len();
         let mut worst = nearest.max(limit);
         let mut member_farther = false;
-        let mut u = self.members[a as usize].1;
+        let mut u = self.place.members[a as usize].1;
         while u != a {
-            let (p, next) = self.members[u as usize];
-            prefetch(&self.members[next as usize]);
+            let (p, next) = self.place.members[u as usize];
+            prefetch(&self.place.members[next as usize]);
             let p = p.as_dvec3();
             u = next;
             if over_within(&after[..moved], p, worst) {
@@ -202,7 +202,9 @@ impl Contractor {
         }
         (forward, wait)
     }
+}
 
+impl<P: Place> Contractor<P> {
     /// [`BACKWARD_WEIGHT`] times the largest squared distance from the
     /// centroid of a triangle that replaces `a`'s fan (moving `a` onto
     /// `b`) to the old surface, the live triangles around `a` and `b`

@@ -170,7 +170,7 @@ pub(super) fn most_crowded_edge(tris: &[[u32; 3]], fans: &Fans) -> usize {
     most as usize
 }
 
-impl Contractor {
+impl<P: Place> Contractor<P> {
     /// The guards of the module docs for contracting `a` into `b` placed at
     /// `target`. Allocation-free; O(valence(a) · valence(b)) at worst.
     pub(super) fn check(&mut self, a: u32, b: u32, target: DVec3) -> Result<(), Reject> {
@@ -193,7 +193,7 @@ impl Contractor {
         if a_edges.slides && ab_triangles == 2 {
             return Err(Reject::Topology);
         }
-        if self.placement == Placement::Optimal {
+        if P::MOVES_KEPT {
             let (b_edges, _) = self.edges_at(b, a);
             if b_edges.slides && ab_triangles == 2 {
                 return Err(Reject::Topology);
@@ -299,7 +299,7 @@ impl Contractor {
         }
         self.fan = fan;
         verdict?;
-        if self.placement == Placement::Optimal {
+        if P::MOVES_KEPT {
             for &t in self.fans.get(b) {
                 let tri = self.tris[t as usize];
                 if self.tris[t as usize][0] != DEAD && !tri.contains(&a) && self.flips(t, b, target)

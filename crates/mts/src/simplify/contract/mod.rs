@@ -70,9 +70,11 @@ mod choice;
 mod cost;
 mod distances;
 mod guards;
+mod placement;
 
 use distances::Prism;
 use guards::{border_slots, creased, most_crowded_edge, Reject, Turn};
+use placement::{Endpoint, Optimal, Place};
 
 use super::collapses::{Collapse, Collapses};
 use super::fans::Fans;
@@ -120,7 +122,15 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
         }
         return result;
     }
-    let mut c = Contractor::new(mesh, options);
+    match options.placement {
+        Placement::Endpoint => contract::<Endpoint>(mesh, options),
+        Placement::Optimal => contract::<Optimal>(mesh, options),
+    }
+}
+
+/// The whole sequence with placement `P`.
+fn contract<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
+    let mut c = Contractor::<P>::new(mesh, options);
     c.run(options.stop_at_triangles);
     c.finish()
 }
@@ -187,29 +197,15 @@ const CREASE_COS: f64 = 0.966;
 /// 0.719, 2 → 0.718, 4 → 0.748, 8 → 0.776.
 const BORDER_WEIGHT: f64 = 1.0;
 
-struct Contractor {
-    placement: Placement,
+struct Contractor<P> {
+    /// The placement strategy and its state.
+    place: P,
     diagonal: f64,
-    /// Positions, `f64`; optimal mode appends one per contraction.
     /// Input positions as loaded (`f32`, half the cache footprint; widened
-    /// exactly on use, see [`Contractor::p`]).
+    /// exactly on use, see [`Contractor::p`]). Created vertices (optimal
+    /// placement) follow them, held by [`Contractor::place`].
     pos: Vec<Vec3>,
-    /// Positions of the vertices optimal mode appends (`f64`, after `pos`;
-    /// rounded to `f32` once, for the output, in [`Contractor::finish`]).
-    appended_pos: Vec<DVec3>,
     quadrics: Vec<Quadric>,
-    /// The input positions each vertex stands for (its own and those
-    /// contracted into it), for the tie-breaking term of
-    /// [`Contractor::cost`]; empty in optimal placement, which does not
-    /// use them.
-    anchors: Vec<PointSum>,
-    /// The input vertices each vertex stands for, as circular lists:
-    /// `members[v]` is `v`'s input position and the next vertex of its
-    /// cycle. A vertex alone points to itself; moving `a` onto `b` joins
-    /// their cycles by swapping the two links. The position sits beside
-    /// the link so a walk loads one line per member. Empty in optimal
-    /// placement, which does not use them.
-    members: Vec<(Vec3, u32)>,
     /// Scratch list of the triangles around the survivor after a move, for
     /// [`Contractor::forward_error`].
     after: Vec<Prism>,
@@ -250,8 +246,8 @@ struct Contractor {
     refusals: Refusals,
     /// Scratch vertex list (neighbours of a survivor).
     ring: Vec<u32>,
-    /// Scratch vertex list (a vertex's partners, in [`Contractor::best`]
-    /// in optimal mode and for the survivor in [`Contractor::contract`]).
+    /// Scratch vertex list (a vertex's partners, in [`Optimal`]'s
+    /// [`Place::best`] and for the survivor in [`Contractor::contract`]).
     around: Vec<u32>,
     /// Output.
     steps: Vec<Collapse>,
@@ -270,8 +266,8 @@ struct Contractor {
     crowding: usize,
 }
 
-impl Contractor {
-    fn new(mesh: &Mesh, options: &SimplifyOptions) -> Contractor {
+impl<P: Place> Contractor<P> {
+    fn new(mesh: &Mesh, options: &SimplifyOptions) -> Contractor<P> {
         let n = mesh.vertex_count();
         let pos = mesh.positions.clone();
         let tris = mesh.triangles.clone();
@@ -301,24 +297,7 @@ impl Contractor {
             };
             normals0.push(normal);
         }
-        // Each vertex's anchor: its own position, weighted like its face
-        // planes (before border planes are added).
-        let anchors = if options.placement == Placement::Endpoint {
-            quadrics
-                .iter()
-                .zip(&mesh.positions)
-                .map(|(q, p)| PointSum::point(p.as_dvec3(), q.weight()))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let members = if options.placement == Placement::Endpoint {
-            (0..n as u32)
-                .map(|v| (mesh.positions[v as usize], v))
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let place = P::new(mesh, &quadrics);
         let fans = Fans::new(n, &tris);
         let crowding = most_crowded_edge(&tris, &fans).max(2);
         if options.boundary_weight > 0.0 {
@@ -372,16 +351,13 @@ impl Contractor {
         }
         let triangles_now = tris.len() as u32;
         let mut c = Contractor {
-            placement: options.placement,
+            place,
             diagonal,
             pos,
             quadrics,
-            anchors,
-            members,
             after: Vec::new(),
             tris,
             normals0,
-            appended_pos: Vec::new(),
             fans,
             partners,
             removed: vec![false; n],
@@ -405,7 +381,7 @@ impl Contractor {
             checked: Vec::new(),
             crowding,
         };
-        c.choose_all();
+        P::choose_all(&mut c);
         c
     }
 
@@ -422,7 +398,7 @@ impl Contractor {
     fn p(&self, v: u32) -> DVec3 {
         match self.pos.get(v as usize) {
             Some(p) => p.as_dvec3(),
-            None => self.appended_pos[v as usize - self.pos.len()],
+            None => self.place.created(v as usize - self.pos.len()),
         }
     }
 
@@ -486,9 +462,7 @@ impl Contractor {
             }
             self.quadrics[a as usize].prefetch();
             self.quadrics[b as usize].prefetch();
-            if let Some(anchor) = self.anchors.get(a as usize) {
-                anchor.prefetch();
-            }
+            self.place.prefetch(a);
             self.fans.prefetch_span(b);
             if self.removed[b as usize] {
                 // The target went away without `a` being next to its
@@ -496,15 +470,12 @@ impl Contractor {
                 self.refresh(a);
                 continue;
             }
-            let target = self.target_position(a, b);
+            let target = P::target(self, a, b);
             match self.check(a, b, target) {
                 Ok(()) => {
                     // The queue's cost is a lower bound (after the guards:
                     // their loads of the fan serve the distances too).
-                    let (forward, wait) = match self.placement {
-                        Placement::Endpoint => self.distances(a, b, cost),
-                        Placement::Optimal => (0.0, 0.0),
-                    };
+                    let (forward, wait) = P::distances(self, a, b, cost);
                     if wait as f32 > cost * (1.0 + 1e-4) {
                         let raised = wait as f32;
                         self.queued[a as usize] = (raised, b);
@@ -544,37 +515,9 @@ impl Contractor {
         if !ring.contains(&b) {
             ring.push(b);
         }
-        // The recorded error: the planes' part of the cost and the
-        // forward distance, without the tie-break.
-        let error = match self.placement {
-            Placement::Endpoint => self.quadrics[a as usize].mean_error(target).max(forward),
-            Placement::Optimal => f64::from(cost),
-        };
+        let error = P::recorded_error(self, a, target, cost, forward);
         let q = self.quadrics[a as usize] + self.quadrics[b as usize];
-        if self.placement == Placement::Endpoint {
-            self.anchors[b as usize] = self.anchors[a as usize] + self.anchors[b as usize];
-            let (after_a, after_b) = (self.members[a as usize].1, self.members[b as usize].1);
-            self.members[a as usize].1 = after_b;
-            self.members[b as usize].1 = after_a;
-        }
-        let survivor = match self.placement {
-            Placement::Endpoint => b,
-            Placement::Optimal => {
-                let c = self.removed.len() as u32;
-                self.appended_pos.push(target);
-                self.quadrics.push(Quadric::default());
-                self.fans.push_vertex();
-                self.removed.push(false);
-                self.mark.push(0);
-                self.queued.push((f32::NAN, NONE));
-                self.floor.push(NO_KEY);
-                self.refusals.push_vertex();
-                if !self.partners.is_empty() {
-                    self.partners.push(Vec::new());
-                }
-                c
-            }
-        };
+        let survivor = P::merge(self, a, b, target);
         self.quadrics[survivor as usize] = q;
         // The survivor's list: b's live triangles without `a`, then `a`'s
         // live ones (which never contain `b`), in b's block when it has room.
@@ -670,9 +613,7 @@ impl Contractor {
             prefetch(&self.queued[v as usize]);
             prefetch(self.fans.get(v));
             self.quadrics[v as usize].prefetch();
-            if let Some(anchor) = self.anchors.get(v as usize) {
-                anchor.prefetch();
-            }
+            self.place.prefetch(v);
         }
         for (i, &v) in ring.iter().enumerate() {
             if let Some(&next) = ring.get(i + 1) {
@@ -697,6 +638,23 @@ impl Contractor {
             }
         }
         self.ring = ring;
+    }
+
+    /// Adds a vertex with no triangles, quadric or choice yet (a
+    /// placement that creates one calls it) and returns it.
+    fn push_vertex(&mut self) -> u32 {
+        let c = self.removed.len() as u32;
+        self.quadrics.push(Quadric::default());
+        self.fans.push_vertex();
+        self.removed.push(false);
+        self.mark.push(0);
+        self.queued.push((f32::NAN, NONE));
+        self.floor.push(NO_KEY);
+        self.refusals.push_vertex();
+        if !self.partners.is_empty() {
+            self.partners.push(Vec::new());
+        }
+        c
     }
 
     fn stop_record(&mut self, reason: StopReason, round: RoundStats) -> Stop {
@@ -729,7 +687,7 @@ impl Contractor {
             self.input_vertices,
             self.steps,
             self.triangle_counts,
-            self.appended_pos.iter().map(|p| p.as_vec3()).collect(),
+            self.place.into_created(),
         );
         Simplification { collapses, stop }
     }
@@ -785,12 +743,12 @@ mod tests {
     /// The fan of apex 0 over the ring 1, 2, 3, 4 at `positions`, with
     /// the move of 0 onto 1 checked: it passes the guards and leaves two
     /// creased triangles in `fan`.
-    fn apex_0_onto_1(positions: [Vec3; 5]) -> (Mesh, Contractor) {
+    fn apex_0_onto_1(positions: [Vec3; 5]) -> (Mesh, Contractor<Endpoint>) {
         let mesh = Mesh {
             positions: positions.to_vec(),
             triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
         };
-        let mut c = Contractor::new(&mesh, &SimplifyOptions::default());
+        let mut c = Contractor::<Endpoint>::new(&mesh, &SimplifyOptions::default());
         let p1 = c.p(1);
         assert!(c.check(0, 1, p1).is_ok());
         assert_eq!(c.fan.len(), 2);
@@ -879,7 +837,7 @@ mod tests {
 
         let mut flat = mesh.clone();
         flat.positions[0].z = 0.0;
-        let mut c = Contractor::new(&flat, &SimplifyOptions::default());
+        let mut c = Contractor::<Endpoint>::new(&flat, &SimplifyOptions::default());
         let p1 = c.p(1);
         assert!(c.check(0, 1, p1).is_ok());
         assert!(!creased(&c.fan));
@@ -904,7 +862,7 @@ mod tests {
             ],
             triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]],
         };
-        let mut c = Contractor::new(&mesh, &SimplifyOptions::default());
+        let mut c = Contractor::<Endpoint>::new(&mesh, &SimplifyOptions::default());
         let p1 = c.p(1);
         assert!(c.check(0, 1, p1).is_ok());
         assert!(c.fan_on_border);
@@ -916,7 +874,7 @@ mod tests {
 
         let mut filled = mesh.clone();
         filled.triangles.push([0, 4, 1]);
-        let mut c = Contractor::new(&filled, &SimplifyOptions::default());
+        let mut c = Contractor::<Endpoint>::new(&filled, &SimplifyOptions::default());
         assert!(c.check(0, 1, p1).is_ok());
         assert!(!c.fan_on_border);
         assert_eq!(c.border_error(0, 1, 0.0), None);
@@ -941,17 +899,17 @@ mod tests {
             ],
             triangles: vec![[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0]],
         };
-        let mut c = Contractor::new(&mesh, &SimplifyOptions::default());
+        let mut c = Contractor::<Endpoint>::new(&mesh, &SimplifyOptions::default());
         let (p0, p1) = (c.p(0), c.p(1));
         assert!(c.check(0, 1, p1).is_ok());
         let alone = c.forward_error(0, 1, 0.0);
-        assert_eq!(c.members[0].1, 0, "0 stands for itself alone");
+        assert_eq!(c.place.members[0].1, 0, "0 stands for itself alone");
 
         assert!(c.check(4, 0, p0).is_ok());
         c.contract(4, 0, p0, 0.0, 0.0);
         assert_eq!(c.triangles_now, 2);
         let mut cycle = vec![0];
-        while let next @ 1.. = c.members[*cycle.last().unwrap() as usize].1 {
+        while let next @ 1.. = c.place.members[*cycle.last().unwrap() as usize].1 {
             cycle.push(next);
         }
         assert_eq!(cycle, [0, 4], "0's cycle holds 4 after the move");
@@ -1022,7 +980,7 @@ mod tests {
     #[test]
     fn a_vertex_where_three_sheets_meet_may_leave_the_line_four_may_not() {
         let three = sheets_on_a_line(&[Vec3::Y, Vec3::NEG_Y, Vec3::Z]);
-        let mut c = Contractor::new(&three, &SimplifyOptions::default());
+        let mut c = Contractor::<Endpoint>::new(&three, &SimplifyOptions::default());
         let (edges, on_01) = c.edges_at(0, 1);
         assert_eq!(on_01, 3);
         assert!(edges.border && !edges.slides);
@@ -1035,7 +993,7 @@ mod tests {
         assert!(c.check(0, 1, p1).is_ok());
 
         let four = sheets_on_a_line(&[Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z]);
-        let mut c = Contractor::new(&four, &SimplifyOptions::default());
+        let mut c = Contractor::<Endpoint>::new(&four, &SimplifyOptions::default());
         let (edges, on_01) = c.edges_at(0, 1);
         assert_eq!(on_01, 4);
         assert!(edges.border && edges.slides);
@@ -1044,7 +1002,7 @@ mod tests {
 
         // A border vertex (an edge of one triangle) slides too.
         let one = sheets_on_a_line(&[Vec3::Y]);
-        let mut c = Contractor::new(&one, &SimplifyOptions::default());
+        let mut c = Contractor::<Endpoint>::new(&one, &SimplifyOptions::default());
         assert!(c.edges_at(0, 1).0.slides);
         assert!(matches!(c.check(0, 4, p4), Err(Reject::Topology)));
     }
