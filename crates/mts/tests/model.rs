@@ -222,10 +222,20 @@ fn small_file() -> Vec<u8> {
     build(&mesh, &SimplifyOptions::default(), &BuildOptions::default()).to_bytes()
 }
 
-fn load_err(bytes: &[u8]) -> String {
-    MtsModel::from_bytes(bytes, Path::new("bad.mts"))
-        .expect_err("corrupt file accepted")
-        .to_string()
+fn load_error(bytes: &[u8]) -> mts::Error {
+    MtsModel::from_bytes(bytes, Path::new("bad.mts")).expect_err("corrupt file accepted")
+}
+
+/// The section and byte offset a load error names (panics on any other
+/// error than a parse error).
+fn place_of(e: &mts::Error) -> (&str, u64) {
+    match e {
+        mts::Error::Parse { file, place, .. } => {
+            assert_eq!(file, Path::new("bad.mts"));
+            (place.element.as_deref().unwrap(), place.byte.unwrap())
+        }
+        other => panic!("expected a parse error, got {other:?}"),
+    }
 }
 
 /// Offset of a section's payload.
@@ -243,47 +253,44 @@ fn section(bytes: &[u8], tag: &[u8; 4]) -> usize {
 #[test]
 fn corrupt_files_get_errors_naming_the_place() {
     let good = small_file();
-    let e = load_err(&good[..good.len() - 7]);
-    assert!(e.contains("bad.mts") && e.contains("truncated"), "{e}");
+    let n = good.len() as u64;
+    // Truncated: the header's file length (byte 16) disagrees.
+    let e = load_error(&good[..good.len() - 7]);
+    assert_eq!(place_of(&e), ("header", 16), "{e}");
     let mut b = good.clone();
     b[0] = b'X';
-    assert!(load_err(&b).contains("not an .mts file"));
+    let e = load_error(&b);
+    assert!(matches!(e, mts::Error::UnknownFormat { .. }), "{e:?}");
     let mut b = good.clone();
     b[8] = 9;
-    assert!(load_err(&b).contains("version 9"));
+    let e = load_error(&b);
+    assert!(matches!(e, mts::Error::UnknownFormat { .. }), "{e:?}");
+    // A flipped byte: the header's checksum (byte 24) disagrees.
     let mut b = good.clone();
-    let n = b.len();
-    b[n - 1] ^= 0x55;
-    assert!(load_err(&b).contains("checksum"));
-    // Past the checksum: absurd counts, bad indices, NaN, bad steps.
+    b[good.len() - 1] ^= 0x55;
+    assert_eq!(place_of(&load_error(&b)), ("header", 24));
+    // Past the checksum: absurd counts, bad indices, NaN, bad steps, each
+    // at the start of its section's payload.
     let meta = section(&good, b"META");
     let mut b = good.clone();
     b[meta..meta + 3].copy_from_slice(&[0xff, 0xff, 0x7f]); // 2,097,151 vertices
     seal(&mut b);
-    let e = load_err(&b);
-    assert!(
-        e.contains("META") && e.contains("vertex count 2097151 exceeds"),
-        "{e}"
-    );
+    assert_eq!(place_of(&load_error(&b)), ("META", meta as u64));
     let posi = section(&good, b"POSI");
     let mut b = good.clone();
     b[posi..posi + 4].copy_from_slice(&f32::NAN.to_le_bytes());
     seal(&mut b);
-    let e = load_err(&b);
-    assert!(
-        e.contains("POSI") && e.contains("vertex 0 is not finite"),
-        "{e}"
-    );
+    assert_eq!(place_of(&load_error(&b)), ("POSI", posi as u64));
     let step = section(&good, b"STEP");
     let mut b = good.clone();
-    b[step] = 0x7e; // removed vertex beyond the vertex count (one-byte varint)
+    b[step] = 0x7e; // a first step whose fields no longer parse as written
     seal(&mut b);
-    let e = load_err(&b);
-    assert!(e.contains("STEP") && e.contains("step 0"), "{e}");
+    assert_eq!(place_of(&load_error(&b)), ("STEP", step as u64));
+    // Bytes after the last section: named at the end of the table.
     let mut b = good.clone();
     b.extend_from_slice(&[0; 16]);
     seal(&mut b);
-    assert!(load_err(&b).contains("section table"));
+    assert_eq!(place_of(&load_error(&b)), ("section table", n));
     // Every truncation and every single-byte flip (sealed) is an error or
     // a valid model, never a panic.
     for cut in (0..good.len()).step_by(7) {

@@ -204,7 +204,9 @@ mod tests {
             triangles: vec![[0, 0, 1]],
             degenerate_in_source: 0,
         };
-        let err = clean(raw, CleanOptions::default(), "empty.ply").unwrap_err();
-        assert!(err.to_string().contains("empty.ply: empty mesh"), "{err}");
+        match clean(raw, CleanOptions::default(), "empty.ply").unwrap_err() {
+            Error::InvalidMesh { source_name, .. } => assert_eq!(source_name, "empty.ply"),
+            other => panic!("expected an invalid-mesh error, got {other:?}"),
+        }
     }
 }
