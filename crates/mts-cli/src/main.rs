@@ -1078,6 +1078,7 @@ fn extract(args: &ExtractArgs) -> Result<()> {
         let mesh = Mesh {
             positions: model.positions().to_vec(),
             triangles: ex.triangles(),
+            properties: Default::default(),
         };
         mts::mesh::io::save_obj(&mesh, out)?;
     }
@@ -1298,6 +1299,7 @@ fn extract_baseline(args: &ExtractArgs) -> Result<()> {
         let m = Mesh {
             positions: mesh.positions.clone(),
             triangles: triangles.clone(),
+            properties: Default::default(),
         };
         mts::mesh::io::save_obj(&m, out)?;
     }

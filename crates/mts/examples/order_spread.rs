@@ -153,6 +153,7 @@ fn renumber(mesh: &Mesh, order: u64) -> Mesh {
     Mesh {
         positions,
         triangles,
+        properties: Default::default(),
     }
 }
 

@@ -543,6 +543,7 @@ fn cluster_view_dependent_cut_is_finer_near_the_eye() {
         let m = Mesh {
             positions: tree.positions().to_vec(),
             triangles: tris.clone(),
+            properties: Default::default(),
         };
         assert!(tris.iter().all(|&t| !mts::mesh::is_degenerate(t)));
         assert!(tris

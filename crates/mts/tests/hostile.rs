@@ -99,6 +99,7 @@ fn coincident_triangles_pair_rank_by_rank() {
     let m = Mesh {
         positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
         triangles,
+        properties: Default::default(),
     };
     let adjacency = TriangleAdjacency::new(&m);
     adjacency.validate(&m).unwrap();
@@ -123,6 +124,7 @@ fn coincident_triangles_build_a_model() {
     let m = Mesh {
         positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
         triangles: vec![[0, 1, 2]; 12_000],
+        properties: Default::default(),
     };
     let (model, _, _) = mts::model::build_from_mesh(&m, &Default::default(), &mut |_, _| {});
     assert_eq!(model.triangle_count(0), 12_000);

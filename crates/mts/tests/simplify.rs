@@ -28,6 +28,7 @@ fn flat_grid(n: u32) -> Mesh {
     Mesh {
         positions,
         triangles,
+        properties: Default::default(),
     }
 }
 
@@ -166,6 +167,7 @@ fn tetrahedron_folds_flat_then_vanishes() {
     let mesh = Mesh {
         positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
         triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        properties: Default::default(),
     };
     let s = simplify(&mesh, &SimplifyOptions::default());
     let c = &s.collapses;
@@ -220,6 +222,7 @@ fn a_hole_of_three_edges_closes() {
             [1, 3, 4],
             [1, 4, 2],
         ],
+        properties: Default::default(),
     };
     let s = simplify(&mesh, &SimplifyOptions::default());
     let c = &s.collapses;

@@ -21,6 +21,7 @@ fn mesh(triangles: Vec<[u32; 3]>) -> Mesh {
             .map(|i| Vec3::new(i as f32, (i * i % 7) as f32, 0.0))
             .collect(),
         triangles,
+        properties: Default::default(),
     }
 }
 

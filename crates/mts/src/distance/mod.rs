@@ -227,6 +227,7 @@ mod tests {
                 Vec3::new(0.0, size, z),
             ],
             triangles: vec![[0, 1, 2], [0, 2, 3]],
+            properties: Default::default(),
         }
     }
 

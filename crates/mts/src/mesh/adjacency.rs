@@ -231,6 +231,7 @@ mod tests {
         Mesh {
             positions: (0..n).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect(),
             triangles,
+            properties: Default::default(),
         }
     }
 

@@ -147,6 +147,7 @@ pub fn clean(
     let mesh = Mesh {
         positions,
         triangles,
+        properties: Default::default(),
     };
     #[cfg(debug_assertions)]
     mesh.validate()

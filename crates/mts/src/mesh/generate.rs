@@ -138,6 +138,7 @@ pub fn icosphere(segments: u32, amplitude: f32, seed: u64) -> Mesh {
     Mesh {
         positions,
         triangles,
+        properties: Default::default(),
     }
 }
 
@@ -176,6 +177,7 @@ pub fn torus(major: u32, minor: u32) -> Mesh {
     Mesh {
         positions,
         triangles,
+        properties: Default::default(),
     }
 }
 
@@ -202,6 +204,7 @@ pub fn grid(columns: u32, rows: u32) -> Mesh {
     Mesh {
         positions,
         triangles,
+        properties: Default::default(),
     }
 }
 

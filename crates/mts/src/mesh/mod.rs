@@ -10,9 +10,11 @@ pub mod adjacency;
 mod clean;
 pub mod generate;
 pub mod io;
+mod properties;
 
 pub use adjacency::{TriangleAdjacency, NO_NEIGHBOUR};
 pub use clean::{clean, CleanOptions, CleanReport, RawMesh};
+pub use properties::{Properties, Texture};
 
 use glam::Vec3;
 
@@ -34,7 +36,9 @@ pub use crate::encoding::is_degenerate;
 ///
 /// Invariants (checked by [`Mesh::validate`]): every index is below
 /// `positions.len()`, every coordinate is finite, no triangle repeats a
-/// vertex index, and every vertex is referenced by some triangle.
+/// vertex index or a point ([`Properties::position_id`]), every vertex is
+/// referenced by some triangle, and the properties keep theirs
+/// ([`Properties::validate`]).
 /// Triangles are counter-clockwise when seen from the front.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Mesh {
@@ -42,6 +46,9 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     /// Triangles as three indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
+    /// Normals, texture coordinates, colours and the points split vertices
+    /// share ([`Properties`]); empty for a mesh of positions only.
+    pub properties: Properties,
 }
 
 impl Mesh {
@@ -168,7 +175,13 @@ impl Mesh {
             if is_degenerate(*tri) {
                 return Err(bad(format!("triangle {t} is degenerate: {tri:?}")));
             }
+            if !self.properties.position_ids.is_empty()
+                && is_degenerate(tri.map(|v| self.properties.position_id(v)))
+            {
+                return Err(bad(format!("triangle {t} repeats a point: {tri:?}")));
+            }
         }
+        self.properties.validate(&self.positions).map_err(bad)?;
         if let Some(v) = referenced.iter().position(|r| !r) {
             return Err(bad(format!("vertex {v} is not referenced")));
         }

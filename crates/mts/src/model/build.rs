@@ -170,6 +170,7 @@ pub fn build_with_progress(
         base: Mesh {
             positions: mesh.positions.clone(),
             triangles: strips.triangles(),
+            properties: Default::default(),
         },
         positions,
         collapses,
@@ -298,6 +299,7 @@ impl Context<'_> {
         let mut band_mesh = Mesh {
             positions: Vec::new(),
             triangles: Vec::new(),
+            properties: Default::default(),
         };
         let mut moved = Vec::with_capacity(2);
         loop {
@@ -1013,6 +1015,7 @@ mod tests {
         let mesh = Mesh {
             positions,
             triangles: strips.triangles(),
+            properties: Default::default(),
         };
         (mesh, strips)
     }
@@ -1080,6 +1083,7 @@ mod tests {
         let mesh = Mesh {
             positions,
             triangles: strips.triangles(),
+            properties: Default::default(),
         };
         let (model, collapses) = model_of(&mesh, &strips, &[(0, 2), (5, 3), (3, 4), (4, 6)]);
         let seq = sequences(&mesh, &model, &collapses);
@@ -1114,6 +1118,7 @@ mod tests {
         let mesh = Mesh {
             positions,
             triangles: strips.triangles(),
+            properties: Default::default(),
         };
         let (model, collapses) = model_of(&mesh, &strips, &[]);
         let ones = model.node_vertex.iter().filter(|&&v| v == 1).count();

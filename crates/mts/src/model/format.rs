@@ -484,6 +484,7 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
     let mesh = Mesh {
         positions: positions[..vertices].to_vec(),
         triangles: strips.triangles(),
+        properties: Default::default(),
     };
     if mesh.triangles.is_empty() {
         return Err(strp.error("the strips draw no triangle"));

@@ -182,6 +182,7 @@ impl MtsModel {
         crate::Mesh {
             positions: self.positions[..self.recipe.collapses.vertex_count()].to_vec(),
             triangles: self.recipe.strips.triangles(),
+            properties: Default::default(),
         }
     }
 

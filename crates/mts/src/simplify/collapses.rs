@@ -357,5 +357,6 @@ fn compact(positions: &[Vec3], triangles: &[[u32; 3]]) -> Mesh {
     Mesh {
         positions: out,
         triangles,
+        properties: Default::default(),
     }
 }

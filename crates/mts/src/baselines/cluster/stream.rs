@@ -151,6 +151,7 @@ impl Decoded {
         Mesh {
             positions,
             triangles,
+            properties: Default::default(),
         }
     }
 }

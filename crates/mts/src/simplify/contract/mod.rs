@@ -115,6 +115,7 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
         let scaled = Mesh {
             positions: crate::mesh::scaled_positions(&mesh.positions, scale),
             triangles: mesh.triangles.clone(),
+            properties: Default::default(),
         };
         let mut result = simplify(&scaled, options);
         for p in &mut result.collapses.appended {
@@ -747,6 +748,7 @@ mod tests {
         let mesh = Mesh {
             positions: positions.to_vec(),
             triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+            properties: Default::default(),
         };
         let mut c = Contractor::<Endpoint>::new(&mesh, &SimplifyOptions::default());
         let p1 = c.p(1);
@@ -861,6 +863,7 @@ mod tests {
                 Vec3::new(0.0, -1.0, 0.0),
             ],
             triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]],
+            properties: Default::default(),
         };
         let mut c = Contractor::<Endpoint>::new(&mesh, &SimplifyOptions::default());
         let p1 = c.p(1);
@@ -898,6 +901,7 @@ mod tests {
                 Vec3::new(0.0, 0.0, 1.5),
             ],
             triangles: vec![[4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0]],
+            properties: Default::default(),
         };
         let mut c = Contractor::<Endpoint>::new(&mesh, &SimplifyOptions::default());
         let (p0, p1) = (c.p(0), c.p(1));
@@ -938,6 +942,7 @@ mod tests {
         let tetrahedron = Mesh {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
             triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+            properties: Default::default(),
         };
         assert_eq!(most(&tetrahedron), 2);
         let one = Mesh {
@@ -974,6 +979,7 @@ mod tests {
         Mesh {
             positions,
             triangles,
+            properties: Default::default(),
         }
     }
 
