@@ -381,6 +381,7 @@ impl MeshSource {
                 positions: mesh.positions,
                 triangles: mesh.triangles,
                 degenerate_in_source: 0,
+                properties: Default::default(),
             };
             let (mesh, report) = mts::mesh::clean(raw, clean, &g.to_string())?;
             Ok((format!("generated {g}"), mesh, report))

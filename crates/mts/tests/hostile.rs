@@ -14,6 +14,7 @@ fn mesh(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Mesh {
         positions: positions.iter().map(|&p| Vec3::from(p)).collect(),
         triangles: triangles.to_vec(),
         degenerate_in_source: 0,
+        properties: Default::default(),
     };
     clean(raw, Default::default(), "test").unwrap().0
 }

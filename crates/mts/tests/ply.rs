@@ -266,6 +266,7 @@ fn missing_coordinates_and_empty_meshes_are_refused() {
         positions: vec![glam::Vec3::ZERO; 3],
         triangles: Vec::new(),
         degenerate_in_source: 0,
+        properties: Default::default(),
     };
     let e = clean(raw, CleanOptions::default(), "test.ply").unwrap_err();
     assert!(

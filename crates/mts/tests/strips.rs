@@ -243,6 +243,7 @@ fn random_mesh() -> impl Strategy<Value = Mesh> {
                     .collect(),
                 triangles: tris,
                 degenerate_in_source: 0,
+                properties: Default::default(),
             };
             mts::mesh::clean(raw, Default::default(), "random")
                 .unwrap()

@@ -50,6 +50,7 @@ pub fn random_surface() -> impl Strategy<Value = Mesh> {
             positions,
             triangles,
             degenerate_in_source: 0,
+            properties: Default::default(),
         };
         mts::mesh::clean(raw, Default::default(), "random")
             .unwrap()
