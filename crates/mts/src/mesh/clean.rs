@@ -113,8 +113,8 @@ pub fn clean(
     };
     let mut point: Vec<u32> = Vec::with_capacity(n);
     let weld_map: Vec<u32> = if options.weld {
-        let mut first_at: HashMap<(u32, u32, u32), u32> = HashMap::with_capacity(n);
-        let mut first: HashMap<((u32, u32, u32), Vec<u32>), u32> = HashMap::with_capacity(n);
+        let mut first_at: HashMap<PositionKey, u32> = HashMap::with_capacity(n);
+        let mut first: HashMap<(PositionKey, Vec<u32>), u32> = HashMap::with_capacity(n);
         (0..n)
             .map(|i| {
                 let k = key(positions_in[i]);
@@ -206,6 +206,9 @@ pub fn clean(
         .expect("clean produced an invalid mesh (internal error)");
     Ok((mesh, report))
 }
+
+/// A position's bits, -0.0 and 0.0 alike (the weld's key).
+type PositionKey = (u32, u32, u32);
 
 /// Checks the property counts and values a source gave, normalising
 /// normals and clamping colours.
