@@ -7,7 +7,7 @@
 mod obj;
 mod ply;
 
-pub use obj::parse_obj;
+pub use obj::{parse_obj, parse_obj_with};
 pub use ply::parse_ply;
 
 use super::{clean, CleanOptions, CleanReport, Mesh, RawMesh};
@@ -104,6 +104,10 @@ impl Format {
 pub struct LoadOptions {
     /// Cleaning options (weld of identical positions).
     pub clean: CleanOptions,
+    /// Read normals, texture coordinates, colours and the texture
+    /// ([`crate::mesh::Properties`]); positions only otherwise (an OBJ's
+    /// vertices are then not split at seams).
+    pub properties: bool,
 }
 
 /// Reads a whole file into memory, refusing files over [`MAX_FILE_BYTES`]
@@ -172,61 +176,104 @@ pub fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<RawMesh> {
 pub fn load(path: &Path, options: LoadOptions) -> Result<(Mesh, CleanReport)> {
     let bytes = read_file(path)?;
     let format = Format::detect(path, &bytes)?;
-    let raw = parse(&bytes, format, path)?;
+    let mut raw = match format {
+        Format::Obj => parse_obj_with(&bytes, path, options.properties)?,
+        _ => parse(&bytes, format, path)?,
+    };
+    if !options.properties {
+        raw.properties = crate::mesh::Properties::default();
+    }
     clean(raw, options.clean, &path.display().to_string())
 }
 
-/// Writes `mesh` as OBJ text (`v` and `f` lines, 1-based indices, shortest
-/// round-tripping floats) to `path`.
+/// Writes `mesh` as OBJ text to `path`: one `v` line per point (vertices
+/// split at a seam share it, so the seam reads back as one), `vt` and `vn`
+/// lines when the mesh has texture coordinates or normals (one per
+/// vertex), and `f` lines with 1-based indices; floats in the shortest
+/// form that reads back to the same bits. Colours are written as
+/// `v x y z r g b`, per point (OBJ has no alpha and no colour seam: the
+/// first vertex of a point gives it). A texture is referenced through a `.mtl` file written beside the
+/// OBJ (`map_Kd`): a file texture by its path, an embedded one written as
+/// an image file beside the OBJ.
 ///
 /// # Errors
 /// [`Error::Io`] naming the file.
 pub fn save_obj(mesh: &Mesh, path: &Path) -> Result<()> {
+    use std::fmt::Write as _;
     use std::io::Write;
-    let io = |source| Error::Io {
-        file: path.to_owned(),
-        source,
-    };
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut w = std::io::BufWriter::new(file);
-    for p in &mesh.positions {
-        writeln!(w, "v {} {} {}", p.x, p.y, p.z).map_err(io)?;
-    }
-    for t in &mesh.triangles {
-        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).map_err(io)?;
-    }
-    w.flush().map_err(io)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::triangulate_polygon;
-
-    /// Every convex polygon from 3 to 40 corners: n - 2 triangles, all
-    /// counter-clockwise like the polygon, covering its area exactly.
-    #[test]
-    fn polygons_keep_winding_and_area() {
-        for n in 3..=40u32 {
-            let corner = |i: u32| {
-                let a = i as f64 / f64::from(n) * std::f64::consts::TAU;
-                (a.cos(), a.sin())
-            };
-            let ids: Vec<u32> = (0..n).collect();
-            let mut out = Vec::new();
-            triangulate_polygon(&ids, &mut out);
-            assert_eq!(out.len(), n as usize - 2, "{n} corners");
-            let mut total = 0.0;
-            for t in &out {
-                let [(ax, ay), (bx, by), (cx, cy)] = t.map(corner);
-                let area = 0.5 * ((bx - ax) * (cy - ay) - (cx - ax) * (by - ay));
-                assert!(area > 0.0, "{n} corners: {t:?} is clockwise");
-                total += area;
-            }
-            let polygon = 0.5 * f64::from(n) * (std::f64::consts::TAU / f64::from(n)).sin();
-            assert!(
-                (total - polygon).abs() < 1e-9,
-                "{n} corners: {total} vs {polygon}"
-            );
+    let io = |file: &Path| {
+        let file = file.to_owned();
+        move |source| Error::Io {
+            file: file.clone(),
+            source,
         }
+    };
+    let props = &mesh.properties;
+    let mut head = String::new();
+    if let Some(texture) = &props.texture {
+        let stem = path
+            .file_stem()
+            .map_or("mesh".into(), |s| s.to_string_lossy());
+        let folder = path.parent().unwrap_or(Path::new(""));
+        let image = match texture {
+            crate::mesh::Texture::File(file) => file.display().to_string(),
+            crate::mesh::Texture::Embedded { mime, bytes } => {
+                let ext = if mime.contains("jpeg") { "jpg" } else { "png" };
+                let name = format!("{stem}.{ext}");
+                std::fs::write(folder.join(&name), bytes).map_err(io(&folder.join(&name)))?;
+                name
+            }
+        };
+        let mtl = format!("{stem}.mtl");
+        std::fs::write(
+            folder.join(&mtl),
+            format!("newmtl textured\nKd 1 1 1\nmap_Kd {image}\n"),
+        )
+        .map_err(io(&folder.join(&mtl)))?;
+        let _ = write!(head, "mtllib {mtl}\nusemtl textured\n");
     }
+    let file = std::fs::File::create(path).map_err(io(path))?;
+    let mut w = std::io::BufWriter::new(file);
+    w.write_all(head.as_bytes()).map_err(io(path))?;
+    let mut points_written = 0;
+    for (i, p) in mesh.positions.iter().enumerate() {
+        // Points are numbered in order of first use: a new one is next.
+        if props.position_id(i as u32) != points_written {
+            continue;
+        }
+        points_written += 1;
+        match &props.colors {
+            Some(c) => {
+                let c = c[i];
+                writeln!(w, "v {} {} {} {} {} {}", p.x, p.y, p.z, c.x, c.y, c.z)
+            }
+            None => writeln!(w, "v {} {} {}", p.x, p.y, p.z),
+        }
+        .map_err(io(path))?;
+    }
+    for t in props.uvs.iter().flatten() {
+        writeln!(w, "vt {} {}", t.x, t.y).map_err(io(path))?;
+    }
+    for n in props.normals.iter().flatten() {
+        writeln!(w, "vn {} {} {}", n.x, n.y, n.z).map_err(io(path))?;
+    }
+    let corner = |v: u32| {
+        let p = props.position_id(v) + 1;
+        let v = v + 1;
+        match (props.uvs.is_some(), props.normals.is_some()) {
+            (false, false) => format!("{p}"),
+            (true, false) => format!("{p}/{v}"),
+            (false, true) => format!("{p}//{v}"),
+            (true, true) => format!("{p}/{v}/{v}"),
+        }
+    };
+    for t in &mesh.triangles {
+        if props.is_empty() {
+            writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)
+        } else {
+            writeln!(w, "f {} {} {}", corner(t[0]), corner(t[1]), corner(t[2]))
+        }
+        .map_err(io(path))?;
+    }
+    w.flush().map_err(io(path))
 }

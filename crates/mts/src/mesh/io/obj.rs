@@ -1,7 +1,21 @@
-//! Wavefront OBJ reader: `v`, `f` and the element counts of `vt`/`vn`;
-//! polygons triangulated by [`super::triangulate_polygon`] (quads as the
-//! fan `tobj` made), all objects and groups merged, lines (`l`),
-//! points (`p`), materials and everything else ignored.
+//! Wavefront OBJ reader: `v`, `f`, and with properties `vt`, `vn` and the
+//! material's `map_Kd`; polygons triangulated by
+//! [`super::triangulate_polygon`] (quads as the fan `tobj` made), all
+//! objects and groups merged, lines (`l`), points (`p`) and everything else
+//! ignored.
+//!
+//! **Properties** ([`parse_obj_with`]): a vertex is a distinct
+//! `(v, vt, vn)` triple of a face corner, so a position with several
+//! texture coordinates or normals becomes several vertices with the
+//! position id of its `v` (a seam); a corner without `vt` or `vn` gets
+//! zero there when the file has them elsewhere. `vt u v [w]` keeps `u v`;
+//! `vn` is normalised by [`crate::mesh::clean`]. The texture is the
+//! `map_Kd` of the first material a face uses (`usemtl`), read from the
+//! `mtllib` file beside the OBJ; a missing or unreadable `.mtl` or a
+//! material without `map_Kd` leaves the mesh untextured with a warning on
+//! stderr, not an error (the geometry is still good). Several materials
+//! with different textures are merged into one mesh with the first
+//! texture and a warning: one mesh has one texture here.
 //!
 //! An own reader rather than `tobj` (used until 2026-12): every error names
 //! the line and byte where it is, text that is not UTF-8 (UTF-16, binary
@@ -17,9 +31,13 @@
 //! [`RawMesh::degenerate_in_source`] instead of vanishing.
 
 use crate::error::{Error, Place, Result};
-use crate::mesh::RawMesh;
-use glam::Vec3;
+use crate::mesh::{RawMesh, Texture};
+use glam::{Vec2, Vec3};
+use std::collections::HashMap;
 use std::path::Path;
+
+/// No `vt` or `vn` at a corner.
+const NONE: u64 = u64::MAX;
 
 /// One face as read: the line it is on and its corners' position indices
 /// (0-based, resolved, not yet checked against the position count).
@@ -50,9 +68,25 @@ struct Reader<'p> {
     positions: Vec<Vec3>,
     texcoord_count: u64,
     normal_count: u64,
+    /// Whether properties are read ([`parse_obj_with`]).
+    properties: bool,
+    texcoords: Vec<Vec2>,
+    normals: Vec<Vec3>,
     /// Faces of the current object, not yet numbered.
     faces: Vec<Face>,
     corners: Vec<u64>,
+    /// The `vt` and `vn` of each corner ([`NONE`] for none), with
+    /// properties.
+    corner_attributes: Vec<(u64, u64)>,
+    /// With properties: the current object's vertices of corners that name
+    /// a `vt` or `vn`, by `(v, vt, vn)`.
+    triples: HashMap<(u64, u64, u64), u32>,
+    /// With properties: the `(v, vt, vn)` of each output vertex.
+    vertex_sources: Vec<(u64, u64, u64)>,
+    /// `mtllib` files named, and the first material a face uses.
+    material_libraries: Vec<String>,
+    current_material: Option<String>,
+    materials_used: Vec<String>,
     highest_texcoord: Highest,
     highest_normal: Highest,
     raw: RawMesh,
@@ -65,7 +99,17 @@ struct Reader<'p> {
     first_face: Option<(u64, u64)>,
 }
 
-/// Parses OBJ text into a raw mesh (geometry only).
+/// Parses OBJ text into a raw mesh (geometry only: [`parse_obj_with`]
+/// without properties).
+///
+/// # Errors
+/// As [`parse_obj_with`].
+pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
+    parse_obj_with(bytes, path, false)
+}
+
+/// Parses OBJ text into a raw mesh, with texture coordinates, normals and
+/// the base-colour texture when `properties` is set (see the module docs).
 ///
 /// # Errors
 /// [`Error::Parse`] naming the line and byte for text that is not UTF-8,
@@ -73,7 +117,7 @@ struct Reader<'p> {
 /// and non-finite coordinates.
 ///
 /// Cost: O(file size) time; memory linear in the elements read.
-pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
+pub fn parse_obj_with(bytes: &[u8], path: &Path, properties: bool) -> Result<RawMesh> {
     let err = |line: u64, byte: u64, message: String| Error::Parse {
         file: path.to_owned(),
         place: Place::line(line).at_byte(byte),
@@ -92,8 +136,17 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
         positions: Vec::new(),
         texcoord_count: 0,
         normal_count: 0,
+        properties,
+        texcoords: Vec::new(),
+        normals: Vec::new(),
         faces: Vec::new(),
         corners: Vec::new(),
+        corner_attributes: Vec::new(),
+        triples: HashMap::new(),
+        vertex_sources: Vec::new(),
+        material_libraries: Vec::new(),
+        current_material: None,
+        materials_used: Vec::new(),
         highest_texcoord: Highest::default(),
         highest_normal: Highest::default(),
         raw: RawMesh::default(),
@@ -159,6 +212,9 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<RawMesh> {
         };
         return Err(reader.error(line, byte, "f", message));
     }
+    if properties {
+        reader.attach_properties();
+    }
     Ok(reader.raw)
 }
 
@@ -220,6 +276,16 @@ impl Reader<'_> {
                     ));
                 }
                 self.texcoord_count += 1;
+                if self.properties {
+                    let mut w = text.split_whitespace().skip(1).map(|w| w.parse::<f32>());
+                    let u = w.next().and_then(|x| x.ok()).unwrap_or(0.0);
+                    let v = w.next().and_then(|x| x.ok()).unwrap_or(0.0);
+                    let t = Vec2::new(u, v);
+                    if !t.is_finite() {
+                        return Err(self.error(line, byte, "vt", "NaN or infinite".into()));
+                    }
+                    self.texcoords.push(t);
+                }
                 Ok(())
             }
             "vn" => {
@@ -234,6 +300,17 @@ impl Reader<'_> {
                     ));
                 }
                 self.normal_count += 1;
+                if self.properties {
+                    let mut n = [0f32; 3];
+                    for (c, w) in n.iter_mut().zip(text.split_whitespace().skip(1)) {
+                        *c = w.parse().unwrap_or(f32::NAN);
+                    }
+                    let n = Vec3::from(n);
+                    if !n.is_finite() {
+                        return Err(self.error(line, byte, "vn", "NaN or infinite".into()));
+                    }
+                    self.normals.push(n);
+                }
                 Ok(())
             }
             "f" => self.face(words, line, byte),
@@ -243,8 +320,21 @@ impl Reader<'_> {
                 }
                 Ok(())
             }
-            // Lines, points, free-form geometry, materials, smoothing groups
-            // and unknown statements carry no triangles.
+            "mtllib" if self.properties => {
+                // File names may hold spaces: the rest of the line.
+                let name = text.trim_start()["mtllib".len()..].trim();
+                if !name.is_empty() {
+                    self.material_libraries.push(name.to_owned());
+                }
+                Ok(())
+            }
+            "usemtl" if self.properties => {
+                let name = text.trim_start()["usemtl".len()..].trim().to_owned();
+                self.current_material = Some(name);
+                Ok(())
+            }
+            // Lines, points, free-form geometry, smoothing groups and
+            // unknown statements carry no triangles.
             _ => Ok(()),
         }
     }
@@ -326,8 +416,14 @@ impl Reader<'_> {
         byte: u64,
     ) -> Result<()> {
         self.first_face.get_or_insert((line, byte));
+        if let Some(m) = &self.current_material {
+            if !self.materials_used.contains(m) {
+                self.materials_used.push(m.clone());
+            }
+        }
         let first = self.corners.len();
         for (k, corner) in words.enumerate() {
+            let mut attributes = (NONE, NONE);
             let mut parts = corner.split('/');
             let counts = [
                 self.positions.len() as u64,
@@ -371,9 +467,18 @@ impl Reader<'_> {
                 };
                 match slot {
                     0 => self.corners.push(resolved),
-                    1 => self.highest_texcoord.see(resolved, line, byte),
-                    _ => self.highest_normal.see(resolved, line, byte),
+                    1 => {
+                        self.highest_texcoord.see(resolved, line, byte);
+                        attributes.0 = resolved;
+                    }
+                    _ => {
+                        self.highest_normal.see(resolved, line, byte);
+                        attributes.1 = resolved;
+                    }
                 }
+            }
+            if self.properties {
+                self.corner_attributes.push(attributes);
             }
             if parts.next().is_some() {
                 return Err(self.error(
@@ -390,6 +495,8 @@ impl Reader<'_> {
         if self.corners.len() - first < 3 {
             // A point or a line written as a face: no triangle, counted.
             self.corners.truncate(first);
+            self.corner_attributes
+                .truncate(first.min(self.corner_attributes.len()));
             self.raw.degenerate_in_source += 1;
             return Ok(());
         }
@@ -430,6 +537,30 @@ impl Reader<'_> {
                         ),
                     ));
                 }
+                let attributes = self
+                    .corner_attributes
+                    .get(c)
+                    .copied()
+                    .unwrap_or((NONE, NONE));
+                if attributes != (NONE, NONE) {
+                    let key = (v, attributes.0, attributes.1);
+                    let next = self.raw.positions.len() as u32;
+                    let id = *self.triples.entry(key).or_insert(next);
+                    if id == next {
+                        if self.raw.positions.len() as u64 >= u64::from(u32::MAX) {
+                            return Err(self.error(
+                                face.line,
+                                face.byte,
+                                "f",
+                                "more than 2^32 - 1 vertices".into(),
+                            ));
+                        }
+                        self.raw.positions.push(self.positions[v as usize]);
+                        self.vertex_sources.push(key);
+                    }
+                    ids.push(id);
+                    continue;
+                }
                 let v = v as usize;
                 if self.stamp[v] != self.object {
                     self.stamp[v] = self.object;
@@ -443,6 +574,9 @@ impl Reader<'_> {
                         ));
                     }
                     self.raw.positions.push(self.positions[v]);
+                    if self.properties {
+                        self.vertex_sources.push((v as u64, NONE, NONE));
+                    }
                 }
                 ids.push(base as u32 + self.local[v]);
             }
@@ -451,7 +585,87 @@ impl Reader<'_> {
         self.faces = faces;
         self.faces.clear();
         self.corners.clear();
+        self.corner_attributes.clear();
+        self.triples.clear();
         Ok(())
+    }
+
+    /// Gives the raw mesh its texture coordinates, normals, position ids
+    /// and texture (after the ranges were checked against the whole file).
+    fn attach_properties(&mut self) {
+        let texture = self.texture();
+        let sources = &self.vertex_sources;
+        let props = &mut self.raw.properties;
+        if sources.iter().any(|s| s.1 != NONE) {
+            props.uvs = Some(
+                sources
+                    .iter()
+                    .map(|s| {
+                        self.texcoords
+                            .get(s.1 as usize)
+                            .copied()
+                            .unwrap_or(Vec2::ZERO)
+                    })
+                    .collect(),
+            );
+        }
+        if sources.iter().any(|s| s.2 != NONE) {
+            props.normals = Some(
+                sources
+                    .iter()
+                    .map(|s| {
+                        self.normals
+                            .get(s.2 as usize)
+                            .copied()
+                            .unwrap_or(Vec3::ZERO)
+                    })
+                    .collect(),
+            );
+        }
+        if props.uvs.is_some() || props.normals.is_some() {
+            props.position_ids = sources.iter().map(|s| s.0 as u32).collect();
+        }
+        props.texture = texture;
+    }
+
+    /// The `map_Kd` of the first material used, from the `mtllib` files
+    /// beside the OBJ (warnings, never errors: see the module docs).
+    fn texture(&self) -> Option<Texture> {
+        let first = self.materials_used.first()?;
+        let folder = self.path.parent().unwrap_or(Path::new(""));
+        let warn = |what: String| {
+            eprintln!("{}: {what}; drawn untextured", self.path.display());
+        };
+        let mut found: Vec<(String, Option<String>)> = Vec::new();
+        for library in &self.material_libraries {
+            let file = folder.join(library);
+            match super::read_file(&file) {
+                Ok(bytes) => found.extend(materials(&String::from_utf8_lossy(&bytes))),
+                Err(e) => warn(format!("material library: {e}")),
+            }
+        }
+        let map_of = |name: &String| {
+            found
+                .iter()
+                .find(|(m, _)| m == name)
+                .and_then(|(_, map)| map.clone())
+        };
+        let Some(map) = map_of(first) else {
+            if !self.material_libraries.is_empty() {
+                warn(format!("material `{first}` has no `map_Kd` texture"));
+            }
+            return None;
+        };
+        if self
+            .materials_used
+            .iter()
+            .any(|m| map_of(m).is_some_and(|other| other != map))
+        {
+            warn(format!(
+                "several materials with different textures; `{first}`'s ({map}) is used for all"
+            ));
+        }
+        Some(Texture::File(folder.join(map)))
     }
 
     /// Texture-coordinate and normal indices against the counts in the
@@ -481,6 +695,26 @@ impl Reader<'_> {
         }
         Ok(())
     }
+}
+
+/// The materials of `.mtl` text with their `map_Kd` file, if any (its
+/// last word: options such as `-s 1 1 1` come before the file name).
+fn materials(text: &str) -> Vec<(String, Option<String>)> {
+    let mut out: Vec<(String, Option<String>)> = Vec::new();
+    for line in text.lines() {
+        let line = line
+            .split_once('#')
+            .map_or(line, |(before, _)| before)
+            .trim();
+        if let Some(name) = line.strip_prefix("newmtl") {
+            out.push((name.trim().to_owned(), None));
+        } else if let Some(args) = line.strip_prefix("map_Kd") {
+            if let (Some(last), Some(file)) = (out.last_mut(), args.split_whitespace().last()) {
+                last.1 = Some(file.to_owned());
+            }
+        }
+    }
+    out
 }
 
 /// How many of `words` there are, or the first that is not a number.
