@@ -294,7 +294,6 @@ impl Context<'_> {
     /// `base_strips`.
     fn segment(&self, mut first: u32, last_lod: u32, base_strips: &Strips) -> Part {
         let counts = self.collapses.triangle_counts();
-        let optimal = self.collapses.is_optimal_placement();
         let mut part = Part::default();
         let mut band_mesh = Mesh {
             positions: Vec::new(),
@@ -323,13 +322,9 @@ impl Context<'_> {
             let mut last = last_lod;
             for k in first + 1..=last_lod {
                 let i = k as usize - 1;
-                let step = &self.collapses.steps()[i];
                 moved.clear();
-                moved.push(step.removed);
-                if optimal {
-                    moved.push(step.kept);
-                }
-                builder.contract(k, &moved, self.collapses.target(i));
+                moved.extend(self.collapses.moves(i));
+                builder.contract(k, &moved);
                 let now = counts[k as usize];
                 if now <= min_drop && builder.indices() as f64 > limit * f64::from(now) {
                     last = k - 1;
@@ -741,9 +736,9 @@ impl Builder {
 
     /// Replays one contraction: the positions of `moved` vertices now hold
     /// `target`, at LoD `lod`.
-    fn contract(&mut self, lod: u32, moved: &[u32], target: u32) {
+    fn contract(&mut self, lod: u32, moves: &[(u32, u32)]) {
         self.touched.clear();
-        for &v in moved {
+        for &(v, target) in moves {
             let mut gp = self.occ_head[v as usize];
             self.occ_head[v as usize] = NONE;
             self.occ_tail[v as usize] = NONE;

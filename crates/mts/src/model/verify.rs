@@ -208,14 +208,9 @@ impl<'m> Oracle<'m> {
     /// contribution in `tally`.
     fn advance(&mut self, lod: usize, tally: &mut Tally) {
         let collapses = self.model.collapses();
-        let optimal = collapses.is_optimal_placement();
         while self.lod < lod {
-            let i = self.lod;
-            let step = collapses.steps()[i];
-            let target = collapses.target(i);
-            self.move_vertex(step.removed, target, tally);
-            if optimal {
-                self.move_vertex(step.kept, target, tally);
+            for (from, to) in collapses.moves(self.lod) {
+                self.move_vertex(from, to, tally);
             }
             self.lod += 1;
         }

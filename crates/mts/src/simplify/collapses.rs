@@ -8,6 +8,13 @@
 //! of the progressive multilevel meshes paper, section "Vertex
 //! representatives"); [`Collapses::representatives`] path-compresses it for
 //! one LoD into the paper's *pc-rep* array.
+//!
+//! On a mesh with seams ([`crate::mesh::Properties::position_ids`]) one
+//! step contracts a point: every vertex of the removed point that live
+//! triangles still use moves onto the kept point's vertex on the same side
+//! of the seam, all at that LoD. The step's [`Collapse`] holds the first
+//! move and [`Collapses::moves`] all of them; the others are the step's
+//! *companions*.
 
 use crate::error::ensure;
 use crate::mesh::{is_degenerate, Mesh};
@@ -35,7 +42,9 @@ pub struct Collapse {
 /// The ordered contraction sequence with its LoD tables.
 ///
 /// Invariants (checked by [`Collapses::validate`]): a vertex is removed at
-/// most once and never used as `kept` after its removal; the triangle-count
+/// most once and never used as `kept` after its removal (companion moves
+/// included); companions exist only with endpoint placement; the
+/// triangle-count
 /// table has `max_lod() + 1` non-increasing entries starting at the input's
 /// triangle count; errors are finite and non-decreasing; the forest links
 /// agree with the steps.
@@ -50,6 +59,11 @@ pub struct Collapses {
     /// Optimal-placement mode: the position of the vertex created by each
     /// step (one per step); empty when contractions keep an endpoint.
     pub(crate) appended: Vec<Vec3>,
+    /// Companion moves `(removed, kept)` of every step, in step order, and
+    /// where each step's start (`max_lod() + 1` offsets); both empty when
+    /// no step has one.
+    pub(crate) companions: Vec<(u32, u32)>,
+    pub(crate) companion_start: Vec<u32>,
     /// Forest: for each vertex (input and appended) its representative once
     /// it is removed, and the LoD from which that link holds (`u32::MAX`
     /// for a vertex never removed).
@@ -71,6 +85,28 @@ impl Collapses {
         triangle_counts: Vec<u32>,
         appended: Vec<Vec3>,
     ) -> Collapses {
+        Collapses::with_companions(vertex_count, steps, triangle_counts, appended, Vec::new())
+    }
+
+    /// [`Collapses::new`] with companion moves: `companions[i]` are step
+    /// `i`'s moves besides its [`Collapse`] (an empty list for none, or no
+    /// list at all).
+    #[must_use]
+    pub(crate) fn with_companions(
+        vertex_count: usize,
+        steps: Vec<Collapse>,
+        triangle_counts: Vec<u32>,
+        appended: Vec<Vec3>,
+        companions: Vec<Vec<(u32, u32)>>,
+    ) -> Collapses {
+        let (mut flat, mut companion_start) = (Vec::new(), Vec::new());
+        if companions.iter().any(|c| !c.is_empty()) {
+            companion_start.push(0);
+            for i in 0..steps.len() {
+                flat.extend(companions.get(i).into_iter().flatten().copied());
+                companion_start.push(flat.len() as u32);
+            }
+        }
         let total = vertex_count + appended.len();
         let mut parent: Vec<u32> = (0..total as u32).collect();
         let mut parent_from_lod = vec![u32::MAX; total];
@@ -84,6 +120,12 @@ impl Collapses {
             };
             parent[s.removed as usize] = target;
             parent_from_lod[s.removed as usize] = lod;
+            if let Some(w) = companion_start.get(i..i + 2) {
+                for &(r, k) in &flat[w[0] as usize..w[1] as usize] {
+                    parent[r as usize] = k;
+                    parent_from_lod[r as usize] = lod;
+                }
+            }
             if optimal {
                 parent[s.kept as usize] = target;
                 parent_from_lod[s.kept as usize] = lod;
@@ -94,6 +136,8 @@ impl Collapses {
             steps,
             triangle_counts,
             appended,
+            companions: flat,
+            companion_start,
             parent,
             parent_from_lod,
         };
@@ -111,6 +155,29 @@ impl Collapses {
         } else {
             (self.vertex_count + i) as u32
         }
+    }
+
+    /// Every vertex move of step `i` as `(from, to)`: `removed → kept` and
+    /// its companions, or in optimal placement both endpoints onto the
+    /// created vertex. A LoD change applies all of them at once.
+    pub fn moves(&self, i: usize) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let s = self.steps[i];
+        let target = self.target(i);
+        let kept = self.is_optimal_placement().then_some((s.kept, target));
+        let companions = match self.companion_start.get(i..i + 2) {
+            Some(w) => &self.companions[w[0] as usize..w[1] as usize],
+            None => &[],
+        };
+        std::iter::once((s.removed, target))
+            .chain(kept)
+            .chain(companions.iter().copied())
+    }
+
+    /// Whether any step moves more than one vertex of a point (the mesh
+    /// has seams).
+    #[must_use]
+    pub fn has_companions(&self) -> bool {
+        !self.companions.is_empty()
     }
 
     /// Whether contractions create new vertices at the quadric's optimum
@@ -217,12 +284,9 @@ impl Collapses {
         let lod = lod.min(self.max_lod());
         rep.clear();
         rep.extend(0..self.parent.len() as u32);
-        let optimal = self.is_optimal_placement();
-        for (i, s) in self.steps[..lod].iter().enumerate().rev() {
-            let target = rep[self.target(i) as usize];
-            rep[s.removed as usize] = target;
-            if optimal {
-                rep[s.kept as usize] = target;
+        for i in (0..lod).rev() {
+            for (from, to) in self.moves(i) {
+                rep[from as usize] = rep[to as usize];
             }
         }
     }
@@ -263,7 +327,13 @@ impl Collapses {
             .chain(&self.appended)
             .copied()
             .collect();
-        compact(&all, &triangles)
+        let (mut out, order) = compact(&all, &triangles);
+        if self.appended.is_empty() {
+            // Endpoint placement: every vertex is an input vertex, with its
+            // input properties.
+            out.properties = mesh.properties.gather(&order);
+        }
+        out
     }
 
     /// Checks the invariants listed on [`Collapses`].
@@ -286,6 +356,14 @@ impl Collapses {
             "Collapses",
             self.appended.is_empty() || self.appended.len() == self.steps.len(),
             "self.appended.is_empty() || self.appended.len() == self.steps.len()"
+        );
+        ensure!(
+            "Collapses",
+            self.companion_start.is_empty()
+                || (self.companion_start.len() == self.steps.len() + 1
+                    && self.companion_start.windows(2).all(|w| w[0] <= w[1])
+                    && *self.companion_start.last().unwrap() as usize == self.companions.len()),
+            "companion table"
         );
         let mut removed_at = vec![u32::MAX; total];
         let mut last_error = 0.0f32;
@@ -321,6 +399,32 @@ impl Collapses {
                     "step {i}: forest link of the kept endpoint"
                 );
             }
+            if let Some(w) = self.companion_start.get(i..i + 2) {
+                ensure!(
+                    "Collapses",
+                    !self.is_optimal_placement(),
+                    "step {i}: companions in optimal placement"
+                );
+                for &(cr, ck) in &self.companions[w[0] as usize..w[1] as usize] {
+                    let (cr, ck) = (cr as usize, ck as usize);
+                    ensure!(
+                        "Collapses",
+                        cr < total && ck < total && cr != ck,
+                        "step {i}: bad companion {cr} -> {ck}"
+                    );
+                    ensure!(
+                        "Collapses",
+                        removed_at[cr] == u32::MAX && removed_at[ck] == u32::MAX,
+                        "step {i}: companion {cr} -> {ck} uses a removed vertex"
+                    );
+                    removed_at[cr] = i as u32;
+                    ensure!(
+                        "Collapses",
+                        self.parent[cr] == ck as u32,
+                        "step {i}: forest link of a companion"
+                    );
+                }
+            }
             ensure!(
                 "Collapses",
                 s.error.is_finite() && s.error >= last_error,
@@ -337,10 +441,12 @@ impl Collapses {
     }
 }
 
-/// `triangles` over `positions` with unreferenced vertices dropped.
-fn compact(positions: &[Vec3], triangles: &[[u32; 3]]) -> Mesh {
+/// `triangles` over `positions` with unreferenced vertices dropped, and
+/// the old vertex of each new one.
+fn compact(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Mesh, Vec<u32>) {
     let mut map = vec![u32::MAX; positions.len()];
     let mut out = Vec::new();
+    let mut order = Vec::new();
     let triangles = triangles
         .iter()
         .map(|t| {
@@ -349,14 +455,18 @@ fn compact(positions: &[Vec3], triangles: &[[u32; 3]]) -> Mesh {
                 if *slot == u32::MAX {
                     *slot = out.len() as u32;
                     out.push(positions[v as usize]);
+                    order.push(v);
                 }
                 *slot
             })
         })
         .collect();
-    Mesh {
-        positions: out,
-        triangles,
-        properties: Default::default(),
-    }
+    (
+        Mesh {
+            positions: out,
+            triangles,
+            properties: Default::default(),
+        },
+        order,
+    )
 }

@@ -637,10 +637,14 @@ impl Reader<'_> {
             eprintln!("{}: {what}; drawn untextured", self.path.display());
         };
         let mut found: Vec<(String, Option<String>)> = Vec::new();
+        let mut read = 0;
         for library in &self.material_libraries {
             let file = folder.join(library);
             match super::read_file(&file) {
-                Ok(bytes) => found.extend(materials(&String::from_utf8_lossy(&bytes))),
+                Ok(bytes) => {
+                    found.extend(materials(&String::from_utf8_lossy(&bytes)));
+                    read += 1;
+                }
                 Err(e) => warn(format!("material library: {e}")),
             }
         }
@@ -651,7 +655,7 @@ impl Reader<'_> {
                 .and_then(|(_, map)| map.clone())
         };
         let Some(map) = map_of(first) else {
-            if !self.material_libraries.is_empty() {
+            if read > 0 {
                 warn(format!("material `{first}` has no `map_Kd` texture"));
             }
             return None;

@@ -308,6 +308,9 @@ impl<P: Place> Contractor<P> {
                 }
             }
         }
+        if !self.corners.is_empty() && !self.seam_map(a, b) {
+            return Err(Reject::Topology);
+        }
         Ok(())
     }
 

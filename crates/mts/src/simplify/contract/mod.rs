@@ -71,6 +71,7 @@ mod cost;
 mod distances;
 mod guards;
 mod placement;
+mod seams;
 
 use distances::Prism;
 use guards::{border_slots, creased, most_crowded_edge, Reject, Turn};
@@ -115,7 +116,7 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
         let scaled = Mesh {
             positions: crate::mesh::scaled_positions(&mesh.positions, scale),
             triangles: mesh.triangles.clone(),
-            properties: Default::default(),
+            properties: mesh.properties.clone(),
         };
         let mut result = simplify(&scaled, options);
         for p in &mut result.collapses.appended {
@@ -123,7 +124,9 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
         }
         return result;
     }
+    let seamed = !mesh.properties.position_ids.is_empty();
     match options.placement {
+        Placement::Endpoint if seamed => contract_points(mesh, options),
         Placement::Endpoint => contract::<Endpoint>(mesh, options),
         Placement::Optimal => contract::<Optimal>(mesh, options),
     }
@@ -132,6 +135,33 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
 /// The whole sequence with placement `P`.
 fn contract<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     let mut c = Contractor::<P>::new(mesh, options);
+    c.run(options.stop_at_triangles);
+    c.finish()
+}
+
+/// The whole sequence of a mesh with seams, contracted point by point
+/// (`seams.rs`). Optimal placement does not take this path yet: it would
+/// need properties for the vertices it creates, and runs on the vertices
+/// as they are (a seam is then a border, and may open).
+fn contract_points(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
+    let ids = &mesh.properties.position_ids;
+    let points = ids.iter().max().map_or(0, |&m| m as usize + 1);
+    let mut positions = vec![Vec3::ZERO; points];
+    for (v, &id) in ids.iter().enumerate() {
+        positions[id as usize] = mesh.positions[v];
+    }
+    let point_mesh = Mesh {
+        positions,
+        triangles: mesh
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| ids[v as usize]))
+            .collect(),
+        properties: Default::default(),
+    };
+    let mut c = Contractor::<Endpoint>::new(&point_mesh, options);
+    c.corners.clone_from(&mesh.triangles);
+    c.output_vertices = mesh.vertex_count();
     c.run(options.stop_at_triangles);
     c.finish()
 }
@@ -201,6 +231,17 @@ const BORDER_WEIGHT: f64 = 1.0;
 struct Contractor<P> {
     /// The placement strategy and its state.
     place: P,
+    /// On a mesh with seams (`seams.rs`), the vertex at each corner of each
+    /// triangle (the triangles of `tris` are over points); empty otherwise.
+    corners: Vec<[u32; 3]>,
+    /// Scratch pairs (vertex of `a`, vertex of `b`) of
+    /// [`Contractor::seam_map`].
+    seam_pairs: Vec<(u32, u32)>,
+    /// Each step's moves besides its [`Collapse`] (seams only).
+    companions: Vec<Vec<(u32, u32)>>,
+    /// Vertices of the output sequence: the input's, or on a mesh with
+    /// seams its vertices (not its points).
+    output_vertices: usize,
     diagonal: f64,
     /// Input positions as loaded (`f32`, half the cache footprint; widened
     /// exactly on use, see [`Contractor::p`]). Created vertices (optimal
@@ -256,7 +297,6 @@ struct Contractor<P> {
     triangles_now: u32,
     max_error: f32,
     stop: Option<Stop>,
-    input_vertices: usize,
     /// Scratch (vertex, count) list for [`Contractor::edges_at`].
     scratch: Vec<(u32, u32)>,
     /// Scratch list of the common neighbours [`Contractor::check`] has
@@ -353,6 +393,10 @@ impl<P: Place> Contractor<P> {
         let triangles_now = tris.len() as u32;
         let mut c = Contractor {
             place,
+            corners: Vec::new(),
+            seam_pairs: Vec::new(),
+            companions: Vec::new(),
+            output_vertices: n,
             diagonal,
             pos,
             quadrics,
@@ -377,7 +421,6 @@ impl<P: Place> Contractor<P> {
             triangles_now,
             max_error: 0.0,
             stop: None,
-            input_vertices: n,
             scratch: Vec::new(),
             checked: Vec::new(),
             crowding,
@@ -545,14 +588,18 @@ impl<P: Place> Contractor<P> {
             self.fans.move_into(b, survivor, |_| true);
             self.removed[b as usize] = true;
         }
+        let (corners, pairs) = (&mut self.corners, &self.seam_pairs);
         self.fans.move_into(a, survivor, |t| {
             let tri = &mut tris[t as usize];
             if tri[0] == DEAD {
                 return false;
             }
-            for w in tri.iter_mut() {
+            for (slot, w) in tri.iter_mut().enumerate() {
                 if *w == a {
                     *w = survivor;
+                    if let Some(c) = corners.get_mut(t as usize) {
+                        c[slot] = Self::seam_target(pairs, c[slot]);
+                    }
                 }
             }
             true
@@ -586,9 +633,16 @@ impl<P: Place> Contractor<P> {
         self.triangles_now -= dead;
         let rms = error.max(0.0).sqrt() / self.diagonal;
         self.max_error = self.max_error.max(rms as f32);
+        let (removed, kept) = if self.corners.is_empty() {
+            (a, b)
+        } else {
+            // The step's first move; the others are its companions.
+            self.companions.push(self.seam_pairs[1..].to_vec());
+            self.seam_pairs[0]
+        };
         self.steps.push(Collapse {
-            removed: a,
-            kept: b,
+            removed,
+            kept,
             error: self.max_error,
         });
         self.triangle_counts.push(self.triangles_now);
@@ -684,11 +738,12 @@ impl<P: Place> Contractor<P> {
 
     fn finish(self) -> Simplification {
         let stop = self.stop.expect("run() records where it stopped");
-        let collapses = Collapses::new(
-            self.input_vertices,
+        let collapses = Collapses::with_companions(
+            self.output_vertices,
             self.steps,
             self.triangle_counts,
             self.place.into_created(),
+            self.companions,
         );
         Simplification { collapses, stop }
     }
