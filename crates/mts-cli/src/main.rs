@@ -342,6 +342,12 @@ struct MeshSource {
     /// Merge vertices with identical positions.
     #[arg(long)]
     weld: bool,
+    /// Read normals, texture coordinates, colours and the texture (OBJ
+    /// vertices are split where a position has several); `simplify` keeps
+    /// every seam and writes them with `-o`. Models (`build`, `extract`,
+    /// ...) do not carry properties yet.
+    #[arg(long)]
+    properties: bool,
 }
 
 impl MeshSource {
@@ -363,16 +369,28 @@ impl MeshSource {
                 return Ok((path.display().to_string(), model));
             }
         }
-        let (name, mesh, _) = self.load()?;
+        let (name, mesh, _) = self.load_for_model()?;
         let (model, _, _) = build_with_bar(&mesh, &Default::default());
         Ok((name, model))
+    }
+
+    /// [`MeshSource::load`] for the commands that build models, cluster
+    /// trees or scenes, which do not carry properties yet.
+    fn load_for_model(&self) -> Result<(String, Mesh, CleanReport)> {
+        if self.properties {
+            bail!("models do not carry vertex properties yet: drop --properties");
+        }
+        self.load()
     }
 
     fn load(&self) -> Result<(String, Mesh, CleanReport)> {
         let clean = CleanOptions { weld: self.weld };
         if let Some(path) = &self.mesh {
-            let (mesh, report) =
-                load(path, LoadOptions { clean }).context("cannot load the mesh")?;
+            let options = LoadOptions {
+                clean,
+                properties: self.properties,
+            };
+            let (mesh, report) = load(path, options).context("cannot load the mesh")?;
             Ok((path.display().to_string(), mesh, report))
         } else {
             let g = self.generated.unwrap_or(Generated::DEFAULT);
@@ -807,7 +825,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Extract(args) => extract(args),
         Command::Bench(args) => bench_cmd(args),
         Command::Demo(args) => {
-            let (name, mesh, _) = args.source.load()?;
+            let (name, mesh, _) = args.source.load_for_model()?;
             demo::run(&name, &mesh, &args.thumbnails)
         }
         Command::Encode(args) => encode(args),
@@ -829,7 +847,7 @@ fn run(cli: &Cli) -> Result<()> {
 const PROGRESS_MIN_TRIANGLES: usize = 200_000;
 
 fn build(args: &BuildArgs) -> Result<()> {
-    let (name, mesh, _) = args.source.load()?;
+    let (name, mesh, _) = args.source.load_for_model()?;
     let options = args.pipeline_options();
     let (model, _, t) = build_with_bar(&mesh, &options);
     let bytes = model.to_bytes();
@@ -1344,7 +1362,7 @@ struct EncodeArgs {
 }
 
 fn encode(args: &EncodeArgs) -> Result<()> {
-    let (name, mesh, _) = args.source.load()?;
+    let (name, mesh, _) = args.source.load_for_model()?;
     let t = Instant::now();
     let tree = mts::baselines::ClusterTree::new(&mesh)?;
     let bytes = tree.to_stream();
@@ -1512,7 +1530,7 @@ fn measure_methods(
 }
 
 fn compare(args: &CompareArgs) -> Result<()> {
-    let (name, mesh, _) = args.source.load()?;
+    let (name, mesh, _) = args.source.load_for_model()?;
     let t = Instant::now();
     let (model, _, _) = build_with_bar(&mesh, &Default::default());
     let mts_ms = t.elapsed().as_secs_f64() * 1e3;
