@@ -458,6 +458,16 @@ struct SimplifyArgs {
     /// Weight of the boundary-preserving planes.
     #[arg(allow_negative_numbers = true, long, value_parser = non_negative::<f64>)]
     boundary_weight: Option<f64>,
+    /// Weight of texture-coordinate distortion in the cost, with
+    /// --properties (an error of 1/weight costs one bounding-box diagonal).
+    #[arg(long, value_name = "WEIGHT")]
+    uv_weight: Option<f32>,
+    /// Weight of normal distortion in the cost, with --properties.
+    #[arg(long, value_name = "WEIGHT")]
+    normal_weight: Option<f32>,
+    /// Weight of colour distortion in the cost, with --properties.
+    #[arg(long, value_name = "WEIGHT")]
+    color_weight: Option<f32>,
     /// Surface samples per side for the error measurement.
     #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES, value_parser = count_in::<1, MAX_SAMPLES>, allow_negative_numbers = true)]
     samples: usize,
@@ -676,6 +686,15 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
         pair_distance: args.pair_distance,
         boundary_weight: args.boundary_weight.unwrap_or(defaults.boundary_weight),
         stop_at_triangles: None,
+        attribute_weights: mts::simplify::AttributeWeights {
+            uv: args.uv_weight.unwrap_or(defaults.attribute_weights.uv),
+            normal: args
+                .normal_weight
+                .unwrap_or(defaults.attribute_weights.normal),
+            color: args
+                .color_weight
+                .unwrap_or(defaults.attribute_weights.color),
+        },
     };
     let t = Instant::now();
     let whole = mts::simplify(&mesh, &options);

@@ -61,6 +61,34 @@ pub struct SimplifyOptions {
     /// then ends there); `None` runs until no valid pair or no triangle
     /// remains.
     pub stop_at_triangles: Option<usize>,
+    /// How much distorting each vertex property costs, on a mesh with
+    /// properties (see [`AttributeWeights`]).
+    pub attribute_weights: AttributeWeights,
+}
+
+/// Weights of the property errors in the contraction cost: an error of
+/// `1 / weight` in a property (UV units, unit-normal components, colour
+/// channels in 0..=1) costs as much as moving the surface by one
+/// bounding-box diagonal. Zero leaves the property out of the cost (seams
+/// are kept whatever the weights).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AttributeWeights {
+    /// Texture coordinates.
+    pub uv: f32,
+    /// Normal components.
+    pub normal: f32,
+    /// Colour channels.
+    pub color: f32,
+}
+
+impl Default for AttributeWeights {
+    fn default() -> AttributeWeights {
+        AttributeWeights {
+            uv: 1.0,
+            normal: 0.1,
+            color: 0.5,
+        }
+    }
 }
 
 impl Default for SimplifyOptions {
@@ -70,6 +98,7 @@ impl Default for SimplifyOptions {
             pair_distance: None,
             boundary_weight: 15.0,
             stop_at_triangles: None,
+            attribute_weights: AttributeWeights::default(),
         }
     }
 }

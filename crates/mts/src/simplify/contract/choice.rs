@@ -129,7 +129,10 @@ impl Contractor<Endpoint> {
             }
             // The tie-break term of `cost`, its centre computed once.
             let p = self.p(w);
-            let cost = q.mean_error(p) + TIE_BREAK * PointSum::spread(p, centre, squares);
+            let mut cost = q.mean_error(p) + TIE_BREAK * PointSum::spread(p, centre, squares);
+            if let Some(a) = &self.attributes {
+                cost += a.cost(v, w, p);
+            }
             if best.is_none_or(|(bc, bw)| cost < bc || (cost == bc && w < bw)) {
                 best = Some((cost, w));
             }

@@ -24,8 +24,12 @@ impl Contractor<Endpoint> {
     /// recorded error leaves it out ([`Contractor::contract`]).
     pub(super) fn cost(&self, removed: u32, kept: u32) -> f64 {
         let p = self.p(kept);
-        self.quadrics[removed as usize].mean_error(p)
-            + TIE_BREAK * self.place.anchors[removed as usize].mean_error(p)
+        let mut cost = self.quadrics[removed as usize].mean_error(p)
+            + TIE_BREAK * self.place.anchors[removed as usize].mean_error(p);
+        if let Some(a) = &self.attributes {
+            cost += a.cost(removed, kept, p);
+        }
+        cost
     }
 }
 

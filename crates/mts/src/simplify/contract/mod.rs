@@ -66,6 +66,7 @@
 //!   in the mean's weight); a vertex on an edge of one triangle, or of
 //!   four or more, leaves only along such an edge (or one of three).
 
+mod attributes;
 mod choice;
 mod cost;
 mod distances;
@@ -159,9 +160,12 @@ fn contract_points(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
             .collect(),
         properties: Default::default(),
     };
-    let mut c = Contractor::<Endpoint>::new(&point_mesh, options);
-    c.corners.clone_from(&mesh.triangles);
-    c.output_vertices = mesh.vertex_count();
+    let mut c = Contractor::<Endpoint>::new_with(&point_mesh, options, |c| {
+        c.corners.clone_from(&mesh.triangles);
+        c.output_vertices = mesh.vertex_count();
+        c.attributes =
+            attributes::Attributes::new(mesh, ids, points, options.attribute_weights, c.diagonal);
+    });
     c.run(options.stop_at_triangles);
     c.finish()
 }
@@ -239,6 +243,8 @@ struct Contractor<P> {
     seam_pairs: Vec<(u32, u32)>,
     /// Each step's moves besides its [`Collapse`] (seams only).
     companions: Vec<Vec<(u32, u32)>>,
+    /// Attribute quadrics of the vertices (a mesh with properties only).
+    attributes: Option<attributes::Attributes>,
     /// Vertices of the output sequence: the input's, or on a mesh with
     /// seams its vertices (not its points).
     output_vertices: usize,
@@ -309,6 +315,15 @@ struct Contractor<P> {
 
 impl<P: Place> Contractor<P> {
     fn new(mesh: &Mesh, options: &SimplifyOptions) -> Contractor<P> {
+        Self::new_with(mesh, options, |_| {})
+    }
+
+    /// [`Contractor::new`] with `setup` run before the first choices.
+    fn new_with(
+        mesh: &Mesh,
+        options: &SimplifyOptions,
+        setup: impl FnOnce(&mut Contractor<P>),
+    ) -> Contractor<P> {
         let n = mesh.vertex_count();
         let pos = mesh.positions.clone();
         let tris = mesh.triangles.clone();
@@ -396,6 +411,7 @@ impl<P: Place> Contractor<P> {
             corners: Vec::new(),
             seam_pairs: Vec::new(),
             companions: Vec::new(),
+            attributes: None,
             output_vertices: n,
             diagonal,
             pos,
@@ -425,6 +441,7 @@ impl<P: Place> Contractor<P> {
             checked: Vec::new(),
             crowding,
         };
+        setup(&mut c);
         P::choose_all(&mut c);
         c
     }
@@ -633,6 +650,11 @@ impl<P: Place> Contractor<P> {
         self.triangles_now -= dead;
         let rms = error.max(0.0).sqrt() / self.diagonal;
         self.max_error = self.max_error.max(rms as f32);
+        if let Some(attributes) = &mut self.attributes {
+            for &(wa, wb) in &self.seam_pairs {
+                attributes.merge(wa, wb);
+            }
+        }
         let (removed, kept) = if self.corners.is_empty() {
             (a, b)
         } else {

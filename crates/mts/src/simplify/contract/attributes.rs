@@ -1,0 +1,255 @@
+//! Appearance in the cost: attribute quadrics (Hoppe, "New quadric metric
+//! for simplifying meshes with appearance attributes", 1999) per vertex of
+//! a mesh with properties, so that a contraction that distorts texture
+//! coordinates, normals or colours costs what it distorts.
+//!
+//! Each triangle defines, per property channel `s` (u, v, nx, ny, nz, r,
+//! g, b, a), the linear function `s(p) = g·p + d` that interpolates its
+//! corners' values over its plane. A vertex accumulates, over the input
+//! triangles it is a corner of (weighted by `sqrt(area)`, as the face
+//! planes are), `Σ w (g·p + d - s)²` as a quadric in `(p, s)`. Moving
+//! vertex `wa` onto `wb` costs the mean of that sum at `wb`'s position and
+//! values: the squared difference between the properties `wa`'s old
+//! triangles showed there and what `wb` carries. Quadrics add when
+//! vertices merge, like the face quadrics.
+//!
+//! **Scale**: channel values are multiplied by [`AttributeWeights`] times
+//! the bounding-box diagonal, so an attribute error of `1 / weight` counts
+//! as much as a geometric error of one diagonal; the cost stays a squared
+//! length and adds to the geometric one. The recorded error (the LoD's
+//! geometric error) leaves it out.
+
+use super::*;
+use crate::mesh::Properties;
+use crate::simplify::AttributeWeights;
+
+/// One channel's quadric: `Σ w (g·p + d - s)²` expanded.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Channel {
+    /// `Σ w g gᵀ` (upper triangle: xx, xy, xz, yy, yz, zz).
+    gg: [f64; 6],
+    /// `Σ w g d`.
+    gd: DVec3,
+    /// `Σ w d²`.
+    dd: f64,
+    /// `Σ w g`.
+    g: DVec3,
+    /// `Σ w d`.
+    d: f64,
+}
+
+impl Channel {
+    fn add_plane(&mut self, g: DVec3, d: f64, w: f64) {
+        let gg = [
+            g.x * g.x,
+            g.x * g.y,
+            g.x * g.z,
+            g.y * g.y,
+            g.y * g.z,
+            g.z * g.z,
+        ];
+        for (a, b) in self.gg.iter_mut().zip(gg) {
+            *a += w * b;
+        }
+        self.gd += w * d * g;
+        self.dd += w * d * d;
+        self.g += w * g;
+        self.d += w * d;
+    }
+
+    fn add(&mut self, o: &Channel) {
+        for (a, b) in self.gg.iter_mut().zip(o.gg) {
+            *a += b;
+        }
+        self.gd += o.gd;
+        self.dd += o.dd;
+        self.g += o.g;
+        self.d += o.d;
+    }
+
+    /// `Σ w (g·p + d - s)²` for total weight `w`.
+    fn evaluate(&self, p: DVec3, s: f64, w: f64) -> f64 {
+        let m = &self.gg;
+        let pgp = m[0] * p.x * p.x
+            + m[3] * p.y * p.y
+            + m[5] * p.z * p.z
+            + 2.0 * (m[1] * p.x * p.y + m[2] * p.x * p.z + m[4] * p.y * p.z);
+        pgp + 2.0 * p.dot(self.gd) + self.dd - 2.0 * s * (self.g.dot(p) + self.d) + s * s * w
+    }
+}
+
+/// The attribute quadrics of every vertex of a mesh with properties, the
+/// scaled property values, and each point's vertices.
+pub(super) struct Attributes {
+    /// Channels per vertex.
+    k: usize,
+    /// `k` scaled values per vertex.
+    values: Vec<f64>,
+    /// `k` channels per vertex.
+    channels: Vec<Channel>,
+    /// Triangle weight per vertex.
+    weight: Vec<f64>,
+    /// Vertices of each point: `point_vertices[point_start[p]..point_start[p + 1]]`.
+    point_start: Vec<u32>,
+    point_vertices: Vec<u32>,
+    /// Vertices moved onto another (their quadric went with them).
+    gone: Vec<bool>,
+}
+
+impl Attributes {
+    /// The quadrics of `mesh`'s vertices (over its own triangles, which
+    /// index vertices) with `ids` the point of each vertex; `None` when
+    /// the mesh has no property stream or every weight is zero.
+    pub(super) fn new(
+        mesh: &Mesh,
+        ids: &[u32],
+        points: usize,
+        weights: AttributeWeights,
+        diagonal: f64,
+    ) -> Option<Attributes> {
+        let p: &Properties = &mesh.properties;
+        let n = mesh.vertex_count();
+        let mut streams: Vec<Box<dyn Fn(usize) -> f64 + '_>> = Vec::new();
+        if let (Some(uvs), w) = (&p.uvs, weights.uv) {
+            if w > 0.0 {
+                let s = f64::from(w) * diagonal;
+                streams.push(Box::new(move |v| s * f64::from(uvs[v].x)));
+                streams.push(Box::new(move |v| s * f64::from(uvs[v].y)));
+            }
+        }
+        if let (Some(normals), w) = (&p.normals, weights.normal) {
+            if w > 0.0 {
+                let s = f64::from(w) * diagonal;
+                for c in 0..3 {
+                    streams.push(Box::new(move |v: usize| {
+                        s * f64::from(normals[v].to_array()[c])
+                    }));
+                }
+            }
+        }
+        if let (Some(colors), w) = (&p.colors, weights.color) {
+            if w > 0.0 {
+                let s = f64::from(w) * diagonal;
+                for c in 0..4 {
+                    streams.push(Box::new(move |v: usize| {
+                        s * f64::from(colors[v].to_array()[c])
+                    }));
+                }
+            }
+        }
+        let k = streams.len();
+        if k == 0 {
+            return None;
+        }
+        let mut values = vec![0.0; n * k];
+        for v in 0..n {
+            for (c, f) in streams.iter().enumerate() {
+                values[v * k + c] = f(v);
+            }
+        }
+        let mut channels = vec![Channel::default(); n * k];
+        let mut weight = vec![0.0; n];
+        for t in &mesh.triangles {
+            let [p0, p1, p2] = t.map(|v| mesh.positions[v as usize].as_dvec3());
+            let (e1, e2) = (p1 - p0, p2 - p0);
+            let area2 = e1.cross(e2).length();
+            let (a, b, c) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+            let det = a * c - b * b;
+            if area2 <= 0.0 || det <= 0.0 || !det.is_finite() {
+                continue;
+            }
+            let w = (0.5 * area2).sqrt();
+            for ch in 0..k {
+                let s = t.map(|v| values[v as usize * k + ch]);
+                let (r1, r2) = (s[1] - s[0], s[2] - s[0]);
+                // g in the plane with g·e1 = r1 and g·e2 = r2.
+                let alpha = (c * r1 - b * r2) / det;
+                let beta = (a * r2 - b * r1) / det;
+                let g = alpha * e1 + beta * e2;
+                let d = s[0] - g.dot(p0);
+                for &v in t {
+                    channels[v as usize * k + ch].add_plane(g, d, w);
+                }
+            }
+            for &v in t {
+                weight[v as usize] += w;
+            }
+        }
+        let mut point_start = vec![0u32; points + 1];
+        for &id in ids {
+            point_start[id as usize + 1] += 1;
+        }
+        for i in 0..points {
+            point_start[i + 1] += point_start[i];
+        }
+        let mut fill = point_start.clone();
+        let mut point_vertices = vec![0u32; n];
+        for (v, &id) in ids.iter().enumerate() {
+            point_vertices[fill[id as usize] as usize] = v as u32;
+            fill[id as usize] += 1;
+        }
+        Some(Attributes {
+            k,
+            values,
+            channels,
+            weight,
+            point_start,
+            point_vertices,
+            gone: vec![false; n],
+        })
+    }
+
+    fn vertices_of(&self, point: u32) -> &[u32] {
+        let p = point as usize;
+        &self.point_vertices[self.point_start[p] as usize..self.point_start[p + 1] as usize]
+    }
+
+    /// `Σ w (s(p) - values of wb)²` of vertex `wa`'s quadric.
+    fn error(&self, wa: u32, wb: u32, p: DVec3) -> f64 {
+        let (a, b) = (wa as usize * self.k, wb as usize * self.k);
+        let w = self.weight[wa as usize];
+        (0..self.k)
+            .map(|c| self.channels[a + c].evaluate(p, self.values[b + c], w))
+            .sum::<f64>()
+            .max(0.0)
+    }
+
+    /// The appearance cost of moving point `a` onto point `b` at `p`: the
+    /// mean, over the triangles of `a`'s vertices, of each vertex's error
+    /// at the vertex of `b` it fits best (the seam guard later fixes the
+    /// pairing; the best fit is its usual outcome and a cheap estimate).
+    pub(super) fn cost(&self, a: u32, b: u32, p: DVec3) -> f64 {
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for &wa in self.vertices_of(a) {
+            if self.gone[wa as usize] || self.weight[wa as usize] == 0.0 {
+                continue;
+            }
+            let best = self
+                .vertices_of(b)
+                .iter()
+                .filter(|&&wb| !self.gone[wb as usize])
+                .map(|&wb| self.error(wa, wb, p))
+                .fold(f64::INFINITY, f64::min);
+            if best.is_finite() {
+                sum += best;
+                weight += self.weight[wa as usize];
+            }
+        }
+        if weight > 0.0 {
+            sum / weight
+        } else {
+            0.0
+        }
+    }
+
+    /// Vertex `wa` moved onto `wb`: its quadric joins `wb`'s.
+    pub(super) fn merge(&mut self, wa: u32, wb: u32) {
+        let k = self.k;
+        for c in 0..k {
+            let from = self.channels[wa as usize * k + c];
+            self.channels[wb as usize * k + c].add(&from);
+        }
+        self.weight[wb as usize] += self.weight[wa as usize];
+        self.gone[wa as usize] = true;
+    }
+}
