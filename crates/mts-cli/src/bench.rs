@@ -7,7 +7,6 @@
 
 use crate::results::{FastSimplificationRun, Figure6Row, MethodRow, Model, Results, Scale};
 use anyhow::{Context, Result};
-use mts::distance::{surface_distance, Surface};
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
 use mts::peers;
 use mts::strip::acmr::{fifo_acmr, CACHE_SIZE};
@@ -462,28 +461,25 @@ pub fn measure_levels(model: &MtsModel) -> Value {
 }
 
 /// Hausdorff and RMS (relative to the diagonal) of the project's LoD and
-/// of meshoptimizer's `simplify` at the same triangle count.
+/// of meshoptimizer's `simplify` at the same triangle count
+/// ([`peers::quality::compare`], as `mts simplify` compares them).
 fn measure_quality(mesh: &Mesh, model: &MtsModel) -> Value {
     let ours_mesh = model.mesh();
     let rows: Vec<Value> = QUALITY_SHARES
         .iter()
         .map(|&share| {
-            // Compared at one triangle count, as `mts simplify` does: where
-            // meshoptimizer stops above ours, ours is taken at its count.
-            let t = Instant::now();
-            let (theirs, lod) = peers::meshopt::simplify_to_lod(
+            let q = peers::quality::compare(
                 mesh,
                 model.collapses(),
                 model.lod_for_ratio(share),
+                SAMPLES,
+                |lod| model.collapses().mesh_at(&ours_mesh, lod),
             );
-            let their_ms = t.elapsed().as_secs_f64() * 1e3;
-            let ours = model.collapses().mesh_at(&ours_mesh, lod);
-            let d = surface_distance(mesh.into(), (&ours).into(), SAMPLES);
-            let e = surface_distance(mesh.into(), Surface::over(mesh, &theirs), SAMPLES);
+            let (d, e) = (q.ours.distance, q.meshopt.distance);
             json!({
                 "share": share,
-                "mts": {"triangles": ours.triangle_count(), "hausdorff": d.hausdorff, "rms": d.rms},
-                "meshopt": {"triangles": theirs.len(), "hausdorff": e.hausdorff, "rms": e.rms, "ms": their_ms},
+                "mts": {"triangles": q.ours.triangle_count, "hausdorff": d.hausdorff, "rms": d.rms},
+                "meshopt": {"triangles": q.meshopt.triangle_count, "hausdorff": e.hausdorff, "rms": e.rms, "ms": q.meshopt_ms},
             })
         })
         .collect();

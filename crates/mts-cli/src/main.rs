@@ -637,7 +637,8 @@ fn strips(args: &StripsArgs) -> Result<()> {
 }
 
 fn simplify(args: &SimplifyArgs) -> Result<()> {
-    use mts::distance::{surface_distance, Surface};
+    use mts::distance::surface_distance;
+    use mts::peers::quality::{self, Measurement};
     use mts::simplify::{Placement, SimplifyOptions};
     let (name, mesh, _) = args.source.load()?;
     let input = mesh.triangle_count();
@@ -666,46 +667,46 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
     let partial = mts::simplify(&mesh, &options);
     let ms_to_target = t.elapsed().as_secs_f64() * 1e3;
     let collapses = &whole.collapses;
-    let mut lod = collapses.lod_for_triangles(target);
+    let lod = collapses.lod_for_triangles(target);
     // The early-stopped run must be a prefix of the whole sequence.
     if partial.collapses.steps() != &collapses.steps()[..partial.collapses.max_lod()] {
         bail!("internal error: the sequence stopped at the target differs from the whole one");
     }
-    // Compare at one triangle count: ours at the target, meshoptimizer
-    // asked for the same; when it stops above it, ours at its count.
-    let mut peer_triangles = None;
     let skipped = peers::meshopt::refusal(&mesh);
     if let Some(why) = &skipped {
         eprintln!("{name}: {why}");
     }
-    if !args.no_meshopt && skipped.is_none() {
-        let ((theirs, at), their_ms) =
-            median_ms(1, || peers::meshopt::simplify_to_lod(&mesh, collapses, lod));
-        lod = at;
-        peer_triangles = Some((theirs, their_ms));
-    }
-    let triangles = collapses.triangles_at(&mesh, lod);
-    let positions: Vec<glam::Vec3> = mesh
-        .positions
-        .iter()
-        .chain(collapses.appended())
-        .copied()
-        .collect();
-    let ours = Surface {
-        positions: &positions,
-        triangles: &triangles,
+    // Our LoD over every input and appended position, referenced or not:
+    // the surface `mts simplify` has always measured (the bench drops the
+    // unreferenced ones, and both keep their own figures).
+    let ours_at = |lod| Mesh {
+        positions: mesh
+            .positions
+            .iter()
+            .chain(collapses.appended())
+            .copied()
+            .collect(),
+        triangles: collapses.triangles_at(&mesh, lod),
     };
-    let d = surface_distance((&mesh).into(), ours, args.samples);
-    let mut peer = serde_json::Value::Null;
-    if let Some((theirs, their_ms)) = peer_triangles {
-        let td = surface_distance((&mesh).into(), Surface::over(&mesh, &theirs), args.samples);
-        peer = json!({
-            "triangles": theirs.len(),
-            "ms": their_ms,
-            "hausdorff": td.hausdorff,
-            "rms": td.rms,
+    // Compare at one triangle count: ours at the target, meshoptimizer
+    // asked for the same; when it stops above it, ours at its count.
+    let (lod, d, peer) = if !args.no_meshopt && skipped.is_none() {
+        let q = quality::compare(&mesh, collapses, lod, args.samples, ours_at);
+        let peer = json!({
+            "triangles": q.meshopt.triangle_count,
+            "ms": q.meshopt_ms,
+            "hausdorff": q.meshopt.distance.hausdorff,
+            "rms": q.meshopt.distance.rms,
         });
-    }
+        (q.lod, q.ours, peer)
+    } else {
+        let ours = ours_at(lod);
+        let d = Measurement {
+            triangle_count: ours.triangle_count(),
+            distance: surface_distance((&mesh).into(), (&ours).into(), args.samples),
+        };
+        (lod, d, serde_json::Value::Null)
+    };
     if let Some(path) = &args.output {
         mts::mesh::io::save_obj(&collapses.mesh_at(&mesh, lod), path)?;
     }
@@ -713,14 +714,14 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
         "mesh": name,
         "input_triangles": input,
         "target": target,
-        "triangles": triangles.len(),
+        "triangles": d.triangle_count,
         "lod": lod,
         "max_lod": collapses.max_lod(),
         "ms": ms,
         "ms_to_target": ms_to_target,
         "quadric_error": collapses.error(lod),
-        "hausdorff": d.hausdorff,
-        "rms": d.rms,
+        "hausdorff": d.distance.hausdorff,
+        "rms": d.distance.rms,
         "stop": whole.stop.to_string(),
         "meshopt": peer,
     });
