@@ -7,7 +7,9 @@ use mts::mesh::io::{load, LoadOptions};
 use mts::mesh::{CleanOptions, CleanReport, Mesh};
 use mts::strip::stats::StripStats;
 use mts::{peers, stripify, StripifyOptions};
+use results::MethodRow;
 use serde_json::json;
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -255,10 +257,9 @@ fn bench_cmd(args: &BenchArgs) -> Result<()> {
         command: std::env::args().collect::<Vec<_>>().join(" "),
         render: !args.no_render,
     };
-    let mut results = bench::run(&options, &|what| {
+    let results = bench::run(&options, &|what| {
         bar.set_message(format!("measuring {what}"))
     })?;
-    results["elapsed_s"] = json!(t.elapsed().as_secs_f64());
     bar.finish_and_clear();
     bench::write(&args.out, &results)?;
     println!(
@@ -540,16 +541,9 @@ fn median_ms<T>(repeat: usize, mut f: impl FnMut() -> T) -> (T, f64) {
     (out.expect("at least one run"), times[times.len() / 2])
 }
 
+/// `mts strips --json`'s figures of one stripifier: the bench's row.
 fn stats_json(s: &StripStats) -> serde_json::Value {
-    json!({
-        "triangles": s.triangles,
-        "strips": s.strips,
-        "swaps": s.swaps,
-        "indices_restart": s.indices_restart,
-        "indices_per_triangle": s.indices_per_triangle,
-        "acmr": s.acmr,
-        "ms": s.ms,
-    })
+    json!(results::StripRow::from(s))
 }
 
 fn strips(args: &StripsArgs) -> Result<()> {
@@ -1464,14 +1458,17 @@ fn measure_methods(
     mesh: &Mesh,
     mts_ms: f64,
     requests: usize,
-) -> Result<Vec<serde_json::Value>> {
+) -> Result<Vec<MethodRow>> {
     use mts::model::sequence;
     let raw = mesh.raw_bytes_u16();
     let mut rows = Vec::new();
     for method in Method::ALL {
         if method == Method::Discrete {
             if let Some(why) = peers::meshopt::refusal(mesh) {
-                rows.push(json!({"method": "discrete", "skipped": why}));
+                rows.push(MethodRow::Skipped {
+                    method: "discrete".into(),
+                    skipped: why,
+                });
                 continue;
             }
         }
@@ -1486,7 +1483,7 @@ fn measure_methods(
             .map(|l| source.triangle_count(l) as u32)
             .collect();
         let sequences = sequence::table2(&counts, requests);
-        let mut us = serde_json::Map::new();
+        let mut us = BTreeMap::new();
         for (label, lods) in &sequences {
             source.set_lod(max_lod);
             let t = Instant::now();
@@ -1494,16 +1491,16 @@ fn measure_methods(
                 source.set_lod(l);
             }
             let per = t.elapsed().as_secs_f64() * 1e6 / lods.len().max(1) as f64;
-            us.insert((*label).to_string(), json!(per));
+            us.insert((*label).to_string(), per);
         }
         let file = source.file_bytes();
-        rows.push(json!({
-            "method": source.name(),
-            "build_ms": build_ms,
-            "memory_bytes": source.memory_bytes(),
-            "file_bytes": file,
-            "file_ratio_to_raw_u16": file as f64 / raw as f64,
-            "us_per_change": us,
+        rows.push(MethodRow::Measured(results::Method {
+            method: source.name().to_string(),
+            build_ms,
+            memory_bytes: source.memory_bytes() as u64,
+            file_bytes: file as u64,
+            file_ratio_to_raw_u16: file as f64 / raw as f64,
+            us_per_change: us,
         }));
     }
     Ok(rows)
@@ -1538,21 +1535,24 @@ fn compare(args: &CompareArgs) -> Result<()> {
         "method", "build ms", "memory B", "file B", "/raw", "us lin", "us exp", "us rand"
     );
     for r in &rows {
-        if let Some(why) = r["skipped"].as_str() {
-            println!("{:<12}{why}", r["method"].as_str().unwrap_or(""));
-            continue;
-        }
-        let f = |v: &serde_json::Value| v.as_f64().unwrap_or(0.0);
+        let r = match r {
+            MethodRow::Measured(r) => r,
+            MethodRow::Skipped { method, skipped } => {
+                println!("{method:<12}{skipped}");
+                continue;
+            }
+        };
+        let us = |seq: &str| r.us_per_change.get(seq).copied().unwrap_or(0.0);
         println!(
             "{:<12}{:>10.1}{:>12}{:>12}{:>8.3}{:>10.1}{:>10.1}{:>10.1}",
-            r["method"].as_str().unwrap_or(""),
-            f(&r["build_ms"]),
-            r["memory_bytes"].as_u64().unwrap_or(0),
-            r["file_bytes"].as_u64().unwrap_or(0),
-            f(&r["file_ratio_to_raw_u16"]),
-            f(&r["us_per_change"]["linear"]),
-            f(&r["us_per_change"]["exponential"]),
-            f(&r["us_per_change"]["random"]),
+            r.method,
+            r.build_ms,
+            r.memory_bytes,
+            r.file_bytes,
+            r.file_ratio_to_raw_u16,
+            us("linear"),
+            us("exponential"),
+            us("random"),
         );
     }
     Ok(())
