@@ -5,15 +5,18 @@
 //! compared with. Timings are medians of a few repetitions; the machine
 //! section names the CPU they come from.
 
-use crate::results::{FastSimplificationRun, Figure6Row, MethodRow, Model, Results, Scale};
+use crate::results::{
+    BuildMs, Bytes, Distance, Extraction, FastSimplification, FastSimplificationRun, Figure6Row,
+    Level, Machine, MethodRow, Model, PeerDistance, Quality, Results, Scale, ScaleExponent,
+    ScaleRow, Scene, Simplify, StripRow, Stripify,
+};
 use anyhow::{Context, Result};
-use mts::distance::{surface_distance, Surface};
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
 use mts::peers;
 use mts::strip::acmr::{fifo_acmr, CACHE_SIZE};
 use mts::strip::stats::StripStats;
 use mts::{Extractor, Mesh, MtsModel, SimplifyOptions, StripifyOptions};
-use serde_json::{json, Value};
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -69,9 +72,16 @@ fn figure6_renderer(wanted: bool) -> Figure6 {
     super::figure6::Renderer::new().map_err(|e| format!("no adapter: {e:#}"))
 }
 
-/// Runs every section and returns `results.json`'s value; `progress` is
-/// told what is being measured.
-pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
+/// Runs every section and returns what `results.json` holds (`elapsed_s`:
+/// this call's wall-clock seconds); `progress` is told what is being
+/// measured.
+///
+/// # Errors
+/// When a model cannot be loaded or built into a renderer's buffers, or a
+/// measurement cannot be read (peak memory, the fast-simplification
+/// peer's rows).
+pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
+    let started = Instant::now();
     let mut models = Vec::new();
     let mut inputs: Vec<(String, Mesh)> = Vec::new();
     if options.models.is_empty() {
@@ -116,7 +126,7 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
         .find(|n| *n == "bunny.ply")
         .or(inputs.first().map(|(n, _)| n))
         .cloned();
-    let mut scene = Value::Null;
+    let mut scene = None;
     for (name, mesh) in &inputs {
         progress(name);
         let (row, model) = measure_model(name, mesh, requests, repeat, &renderer, shares, frames)?;
@@ -126,40 +136,50 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Value> {
         }
     }
     let scale = if options.quick {
-        Value::Null
+        None
     } else {
         progress("scale");
-        measure_scale(progress)
+        Some(measure_scale(progress)?)
     };
-    Ok(json!({
-        "schema": SCHEMA_VERSION,
-        "command": options.command,
-        "quick": options.quick,
-        "machine": machine(&renderer),
-        "models": models,
-        "scene": scene,
-        "scale": scale,
-        "fast_simplification": if options.quick {
-            Value::Null
-        } else {
-            progress("fast-simplification");
-            fast_simplification(&options.models)
-        },
-    }))
+    let machine = machine(&renderer);
+    let fast_simplification = if options.quick {
+        None
+    } else {
+        progress("fast-simplification");
+        Some(fast_simplification(&options.models)?)
+    };
+    Ok(Results {
+        schema: SCHEMA_VERSION,
+        command: options.command.clone(),
+        elapsed_s: started.elapsed().as_secs_f64(),
+        quick: options.quick,
+        machine,
+        models,
+        scale,
+        fast_simplification,
+        scene,
+    })
 }
 
 /// The fast-simplification peer (`crates/mts-cli/peers/fast_simplification.py`)
 /// at 10% and 1% of every model, its error measured by this binary's `mts
-/// distance`: one row per model and share, or `{"skipped": why}` when
-/// Python or the package is missing (`pip install fast-simplification
-/// numpy`).
-fn fast_simplification(models: &[PathBuf]) -> Value {
+/// distance`: one row per model and share, or why there are none (Python
+/// or the package missing: `pip install fast-simplification numpy`).
+///
+/// # Errors
+/// When the script prints a JSON line that is not a row's layout.
+fn fast_simplification(models: &[PathBuf]) -> Result<FastSimplificationRun> {
+    let skipped = |why: &str| {
+        Ok(FastSimplificationRun::Skipped {
+            skipped: why.to_string(),
+        })
+    };
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("peers/fast_simplification.py");
     let Ok(exe) = std::env::current_exe() else {
-        return json!({"skipped": "cannot find this binary for `mts distance`"});
+        return skipped("cannot find this binary for `mts distance`");
     };
     if models.is_empty() {
-        return json!({"skipped": "no model files"});
+        return skipped("no model files");
     }
     let out = std::process::Command::new("python3")
         .arg(&script)
@@ -167,34 +187,42 @@ fn fast_simplification(models: &[PathBuf]) -> Value {
         .arg(&exe)
         .args(models)
         .output();
-    match out {
-        Err(e) => json!({"skipped": format!("python3: {e}")}),
-        Ok(o) if !o.status.success() => json!({
-            "skipped": String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or("failed").to_string()
-        }),
-        Ok(o) => Value::Array(
-            String::from_utf8_lossy(&o.stdout)
-                .lines()
-                .filter_map(|l| serde_json::from_str::<Value>(l).ok())
-                .map(|mut v| {
-                    // The file name, as the models' rows name them.
-                    if let Some(name) = v["mesh"]
-                        .as_str()
-                        .and_then(|m| Path::new(m).file_name())
-                        .map(|n| n.to_string_lossy().into_owned())
-                    {
-                        v["mesh"] = Value::from(name);
-                    }
-                    v
-                })
-                .collect(),
-        ),
+    let o = match out {
+        Err(e) => return skipped(&format!("python3: {e}")),
+        Ok(o) if !o.status.success() => {
+            return skipped(
+                String::from_utf8_lossy(&o.stderr)
+                    .lines()
+                    .last()
+                    .unwrap_or("failed"),
+            )
+        }
+        Ok(o) => o,
+    };
+    let mut rows = Vec::new();
+    for line in String::from_utf8_lossy(&o.stdout).lines() {
+        let mut row: FastSimplification = match serde_json::from_str(line) {
+            Ok(row) => row,
+            // A line that is not JSON (something the package printed) is
+            // no row; a JSON line of another layout is the script's bug.
+            Err(e) if e.is_syntax() || e.is_eof() => continue,
+            Err(e) => anyhow::bail!(
+                "{}: a row of another layout ({e}): {line}",
+                script.display()
+            ),
+        };
+        // The file name, as the models' rows name them.
+        if let Some(name) = Path::new(&row.mesh).file_name() {
+            row.mesh = name.to_string_lossy().into_owned();
+        }
+        rows.push(row);
     }
+    Ok(FastSimplificationRun::Rows(rows))
 }
 
 /// CPU, cores and system of this machine, and the graphics adapter of
-/// Figure 6 (`null` when none ran, with the reason in `adapter_note`).
-fn machine(renderer: &Figure6) -> Value {
+/// Figure 6 (`None` when none ran, with the reason in `adapter_note`).
+fn machine(renderer: &Figure6) -> Machine {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
@@ -214,16 +242,17 @@ fn machine(renderer: &Figure6) -> Value {
             })
         })
         .unwrap_or_else(|| std::env::consts::OS.into());
-    json!({
-        "cpu": cpu,
-        "cores": std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
-        "os": os,
-        "adapter": match renderer {
-            Ok(r) => Value::from(r.adapter()),
-            Err(_) => Value::Null,
-        },
-        "adapter_note": renderer.as_ref().err().cloned(),
-    })
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
+    Machine {
+        cpu,
+        cores: u32::try_from(cores).unwrap_or(u32::MAX),
+        os,
+        adapter: renderer
+            .as_ref()
+            .ok()
+            .map(super::figure6::Renderer::adapter),
+        adapter_note: renderer.as_ref().err().cloned(),
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -245,7 +274,8 @@ fn time_us(repeat: usize, mut f: impl FnMut()) -> f64 {
 }
 
 /// The scene row: [`SCENE_INSTANCES`] instances (fewer with `--quick`) of
-/// `model` on Figure 6's adapter; `null` without one.
+/// `model` on Figure 6's adapter; `None` without one, or where the scene
+/// would refuse that many instances.
 fn measure_scene(
     name: &str,
     model: &MtsModel,
@@ -253,7 +283,7 @@ fn measure_scene(
     frames: usize,
     renderer: &Figure6,
     progress: &dyn Fn(&str),
-) -> Result<Value> {
+) -> Result<Option<Scene>> {
     let instances = if quick {
         QUICK_SCENE_INSTANCES
     } else {
@@ -262,13 +292,11 @@ fn measure_scene(
     match renderer {
         Ok(r) => {
             progress(&format!("scene of {instances} × {name}"));
-            let mut row = r.measure_scene(model, instances, frames)?;
-            row["model"] = Value::from(name);
-            Ok(row)
+            r.measure_scene(name, model, instances, frames)
         }
         Err(_) => {
             let _ = (name, model, instances, frames, progress);
-            Ok(Value::Null)
+            Ok(None)
         }
     }
 }
@@ -299,22 +327,23 @@ fn interleaved_ms<A, B>(
 
 /// The project's stripifier against meshoptimizer's on `mesh` (the `mts
 /// strips` row): both strip sets' figures and median milliseconds.
-fn measure_stripify(mesh: &Mesh, repeat: usize) -> Value {
+fn measure_stripify(mesh: &Mesh, repeat: usize) -> Stripify {
     let options = StripifyOptions::default();
     let ((ours, ms), (theirs, their_ms)) = interleaved_ms(
         repeat,
         || mts::stripify(mesh, &options),
         || peers::meshopt::stripify(mesh),
     );
-    let mut v = super::stats_json(&StripStats::new(&ours, ms));
-    v["meshopt"] = super::stats_json(&StripStats::new(&theirs, their_ms));
-    v
+    Stripify {
+        mts: StripRow::from(&StripStats::new(&ours, ms)),
+        meshopt: StripRow::from(&StripStats::new(&theirs, their_ms)),
+    }
 }
 
 /// The whole contraction sequence (default options) against
 /// meshoptimizer's `simplify` to 10% and to 1% of the triangles, median
 /// milliseconds of interleaved runs.
-fn measure_simplify(mesh: &Mesh, repeat: usize) -> Value {
+fn measure_simplify(mesh: &Mesh, repeat: usize) -> Simplify {
     let n = mesh.triangle_count();
     let ((whole, ms), (_, to_10)) = interleaved_ms(
         repeat,
@@ -324,13 +353,13 @@ fn measure_simplify(mesh: &Mesh, repeat: usize) -> Value {
     let to_1 = time_us(1, || {
         std::hint::black_box(peers::meshopt::simplify(mesh, n / 100));
     }) / 1e3;
-    json!({
-        "ms": ms,
-        "max_lod": whole.collapses.max_lod(),
-        "stop": whole.stop.to_string(),
-        "meshopt_ms_to_10": to_10,
-        "meshopt_ms_to_1": to_1,
-    })
+    Simplify {
+        ms,
+        max_lod: whole.collapses.max_lod() as u64,
+        stop: whole.stop.to_string(),
+        meshopt_ms_to_10: to_10,
+        meshopt_ms_to_1: to_1,
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -342,44 +371,46 @@ fn measure_model(
     renderer: &Figure6,
     shares: &[f64],
     frames: usize,
-) -> Result<(Value, MtsModel)> {
+) -> Result<(Model, MtsModel)> {
     let (model, _, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let file_bytes = model.to_bytes().len();
     let stats = model.stats();
-    let row = json!({
-        "name": name,
-        "triangles": mesh.triangle_count(),
-        "vertices": mesh.vertex_count(),
-        "strips": model.base_strips().run_count(),
-        "max_lod": model.max_lod(),
-        "bands": model.band_count(),
-        "bytes": {
-            "raw": model.raw_bytes(),
-            "raw_u16": model.raw_bytes_u16(),
-            "mts_file": file_bytes,
-            "mts_memory": stats.memory_bytes,
+    // Struct fields are evaluated as written: the sections run in this
+    // order.
+    let row = Model {
+        name: name.to_string(),
+        triangles: mesh.triangle_count() as u64,
+        vertices: mesh.vertex_count() as u64,
+        strips: model.base_strips().run_count() as u64,
+        max_lod: model.max_lod() as u64,
+        bands: model.band_count() as u64,
+        bytes: Bytes {
+            raw: model.raw_bytes() as u64,
+            raw_u16: model.raw_bytes_u16() as u64,
+            mts_file: file_bytes as u64,
+            mts_memory: stats.memory_bytes as u64,
         },
-        "build_ms": {
-            "stripify": ms(t.stripify),
-            "simplify": ms(t.simplify),
-            "model": ms(t.model),
-            "total": ms(t.total),
+        build_ms: BuildMs {
+            stripify: ms(t.stripify),
+            simplify: ms(t.simplify),
+            model: ms(t.model),
+            total: ms(t.total),
         },
-        "stripify": measure_stripify(mesh, repeat),
-        "simplify": measure_simplify(mesh, repeat),
-        "extraction": measure_sequences(&model, requests),
-        "levels": measure_levels(&model),
-        "quality": measure_quality(mesh, &model),
-        "methods": super::measure_methods(&model, mesh, ms(t.total), requests)?,
-        "figure6": match renderer {
-            Ok(r) => r.measure(&model, mesh, shares, frames)?,
+        stripify: measure_stripify(mesh, repeat),
+        simplify: measure_simplify(mesh, repeat),
+        extraction: measure_sequences(&model, requests),
+        levels: measure_levels(&model),
+        quality: measure_quality(mesh, &model),
+        methods: super::measure_methods(&model, mesh, ms(t.total), requests)?,
+        figure6: match renderer {
+            Ok(r) => Some(r.measure(&model, mesh, shares, frames)?),
             Err(_) => {
                 let _ = (shares, frames);
-                Value::Null
+                None
             }
         },
-    });
+    };
     Ok((row, model))
 }
 
@@ -387,8 +418,8 @@ fn measure_model(
 /// coherence cache and from scratch: medians of five passes each, the two
 /// interleaved (a drift of the machine's speed hits both alike), each
 /// pass from a fresh extractor whose construction is not timed.
-fn measure_sequences(model: &MtsModel, requests: usize) -> Value {
-    let mut out = serde_json::Map::new();
+fn measure_sequences(model: &MtsModel, requests: usize) -> BTreeMap<String, Extraction> {
+    let mut out = BTreeMap::new();
     for (seq, lods) in sequence::table2(model.triangle_counts(), requests) {
         let n = lods.len().max(1) as f64;
         let pass = |coherent: bool| {
@@ -411,24 +442,24 @@ fn measure_sequences(model: &MtsModel, requests: usize) -> Value {
         let (coherent, scratch) = (median(coherent), median(scratch));
         out.insert(
             seq.into(),
-            json!({
-                "requests": lods.len(),
-                "mts_coherent_us": coherent / n,
-                "mts_scratch_us": scratch / n,
-            }),
+            Extraction {
+                requests: lods.len() as u64,
+                mts_coherent_us: coherent / n,
+                mts_scratch_us: scratch / n,
+            },
         );
     }
-    Value::Object(out)
+    out
 }
 
 /// Tables 3–4: indices sent at each share — MTS strips (restart values
 /// included), the triangle list, meshoptimizer's strips of that level's
 /// mesh — with ACMR (16-entry FIFO) of each order.
-pub fn measure_levels(model: &MtsModel) -> Value {
+pub fn measure_levels(model: &MtsModel) -> Vec<Level> {
     let mesh = model.mesh();
     let mut ex = Extractor::new(model);
     let mut compact = Vec::new();
-    let levels: Vec<Value> = SHARES
+    SHARES
         .iter()
         .map(|&share| {
             let lod = model.lod_for_ratio(share);
@@ -444,50 +475,57 @@ pub fn measure_levels(model: &MtsModel) -> Value {
                 peers::meshopt::optimize_vertex_cache(&level.triangles, level.vertex_count());
             let theirs = peers::meshopt::stripify(&level);
             let triangles = model.triangle_count(lod);
-            json!({
-                "share": share,
-                "lod": lod,
-                "triangles": triangles,
-                "extract_us": us,
-                "mts_indices": ex.indices_sent(),
-                "list_indices": 3 * triangles,
-                "meshopt_strip_indices": theirs.restart_index_count(),
-                "mts_acmr": fifo_acmr(&strip_triangles, vertices, CACHE_SIZE),
-                "list_acmr": fifo_acmr(&list_triangles, level.vertex_count(), CACHE_SIZE),
-                "meshopt_strip_acmr": fifo_acmr(&theirs.triangles(), level.vertex_count(), CACHE_SIZE),
-            })
+            Level {
+                share,
+                lod: lod as u64,
+                triangles: triangles as u64,
+                mts_indices: ex.indices_sent() as u64,
+                list_indices: 3 * triangles as u64,
+                meshopt_strip_indices: theirs.restart_index_count() as u64,
+                mts_acmr: fifo_acmr(&strip_triangles, vertices, CACHE_SIZE),
+                list_acmr: fifo_acmr(&list_triangles, level.vertex_count(), CACHE_SIZE),
+                meshopt_strip_acmr: fifo_acmr(
+                    &theirs.triangles(),
+                    level.vertex_count(),
+                    CACHE_SIZE,
+                ),
+                extract_us: us,
+            }
         })
-        .collect();
-    Value::Array(levels)
+        .collect()
 }
 
 /// Hausdorff and RMS (relative to the diagonal) of the project's LoD and
-/// of meshoptimizer's `simplify` at the same triangle count.
-fn measure_quality(mesh: &Mesh, model: &MtsModel) -> Value {
+/// of meshoptimizer's `simplify` at the same triangle count
+/// ([`peers::quality::compare`], as `mts simplify` compares them).
+fn measure_quality(mesh: &Mesh, model: &MtsModel) -> Vec<Quality> {
     let ours_mesh = model.mesh();
-    let rows: Vec<Value> = QUALITY_SHARES
+    QUALITY_SHARES
         .iter()
         .map(|&share| {
-            // Compared at one triangle count, as `mts simplify` does: where
-            // meshoptimizer stops above ours, ours is taken at its count.
-            let t = Instant::now();
-            let (theirs, lod) = peers::meshopt::simplify_to_lod(
+            let q = peers::quality::compare(
                 mesh,
                 model.collapses(),
                 model.lod_for_ratio(share),
+                SAMPLES,
+                |lod| model.collapses().mesh_at(&ours_mesh, lod),
             );
-            let their_ms = t.elapsed().as_secs_f64() * 1e3;
-            let ours = model.collapses().mesh_at(&ours_mesh, lod);
-            let d = surface_distance(mesh.into(), (&ours).into(), SAMPLES);
-            let e = surface_distance(mesh.into(), Surface::over(mesh, &theirs), SAMPLES);
-            json!({
-                "share": share,
-                "mts": {"triangles": ours.triangle_count(), "hausdorff": d.hausdorff, "rms": d.rms},
-                "meshopt": {"triangles": theirs.len(), "hausdorff": e.hausdorff, "rms": e.rms, "ms": their_ms},
-            })
+            Quality {
+                share,
+                mts: Distance {
+                    triangles: q.ours.triangle_count as u64,
+                    hausdorff: q.ours.distance.hausdorff,
+                    rms: q.ours.distance.rms,
+                },
+                meshopt: PeerDistance {
+                    triangles: q.meshopt.triangle_count as u64,
+                    hausdorff: q.meshopt.distance.hausdorff,
+                    rms: q.meshopt.distance.rms,
+                    ms: q.meshopt_ms,
+                },
+            }
         })
-        .collect();
-    Value::Array(rows)
+        .collect()
 }
 
 /// Peak resident memory of this process so far (Linux), in bytes.
@@ -500,7 +538,10 @@ fn peak_rss() -> Option<u64> {
 
 /// Build time, memory and extraction time of generated icospheres from
 /// 10K to 4M triangles, with the exponent of a power law fitted to each.
-fn measure_scale(progress: &dyn Fn(&str)) -> Value {
+///
+/// # Errors
+/// When the process's peak memory cannot be read (`/proc/self/status`).
+fn measure_scale(progress: &dyn Fn(&str)) -> Result<Scale> {
     let mut rows = Vec::new();
     for size in SCALE_SIZES {
         let g: mts::mesh::generate::Generated = format!("icosphere:{size}")
@@ -529,39 +570,40 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Value {
             || mts::simplify(&mesh, &SimplifyOptions::default()),
             || peers::meshopt::simplify(&mesh, n / 10),
         );
-        rows.push(json!({
-            "triangles": mesh.triangle_count(),
-            "stripify_ms": stripify_ms,
-            "meshopt_stripify_ms": meshopt_stripify_ms,
-            "simplify_ms": simplify_ms,
-            "meshopt_simplify_to_10_ms": meshopt_simplify_ms,
-            "build_ms": t.total.as_secs_f64() * 1e3,
-            "model_bytes": model_bytes,
-            "peak_rss_bytes": rss,
-            "extract_lod0_us": extract_us,
-        }));
+        rows.push(ScaleRow {
+            triangles: mesh.triangle_count() as u64,
+            stripify_ms,
+            meshopt_stripify_ms,
+            simplify_ms,
+            meshopt_simplify_to_10_ms: meshopt_simplify_ms,
+            build_ms: t.total.as_secs_f64() * 1e3,
+            model_bytes: model_bytes as u64,
+            extract_lod0_us: extract_us,
+            peak_rss_bytes: rss
+                .context("cannot read the peak memory (VmHWM of /proc/self/status)")?,
+        });
     }
-    let fit = |key: &str| {
+    // NaN where no exponent fits: it is written as null, which `write`
+    // refuses, naming the key.
+    let fit = |y: fn(&ScaleRow) -> f64| {
         let points: Vec<(f64, f64)> = rows
             .iter()
-            .filter_map(|r| Some((r["triangles"].as_f64()?, r[key].as_f64()?)))
+            .map(|r| (r.triangles as f64, y(r)))
             .filter(|&(x, y)| x > 0.0 && y > 0.0)
             .map(|(x, y)| (x.ln(), y.ln()))
             .collect();
-        growth_exponent(&points)
+        growth_exponent(&points).unwrap_or(f64::NAN)
     };
-    json!({
-        "rows": rows,
-        "exponent": {
-            "stripify_ms": fit("stripify_ms"),
-            "meshopt_stripify_ms": fit("meshopt_stripify_ms"),
-            "simplify_ms": fit("simplify_ms"),
-            "meshopt_simplify_to_10_ms": fit("meshopt_simplify_to_10_ms"),
-            "build_ms": fit("build_ms"),
-            "model_bytes": fit("model_bytes"),
-            "extract_lod0_us": fit("extract_lod0_us"),
-        },
-    })
+    let exponent = ScaleExponent {
+        stripify_ms: fit(|r| r.stripify_ms),
+        meshopt_stripify_ms: fit(|r| r.meshopt_stripify_ms),
+        simplify_ms: fit(|r| r.simplify_ms),
+        meshopt_simplify_to_10_ms: fit(|r| r.meshopt_simplify_to_10_ms),
+        build_ms: fit(|r| r.build_ms),
+        model_bytes: fit(|r| r.model_bytes as f64),
+        extract_lod0_us: fit(|r| r.extract_lod0_us),
+    };
+    Ok(Scale { rows, exponent })
 }
 
 /// Least-squares slope of `(ln x, ln y)` points: the exponent `k` of
@@ -972,17 +1014,20 @@ pub fn report(results: &Results) -> String {
 }
 
 /// Writes `report.md` and `results.json` into `dir` (created if needed),
-/// after checking `results` against the typed layout
-/// ([`crate::results::Results`]): a key the bench failed to write, or a
-/// NaN it produced, stops here with the key named.
-pub fn write(dir: &Path, results: &Value) -> Result<()> {
-    let typed = crate::results::Results::from_value(results.clone())?;
+/// after checking that `results` reads back ([`Results::from_value`]): a
+/// NaN the bench produced is written as `null`, which stops here with the
+/// key named.
+///
+/// # Errors
+/// When `results` holds a NaN, or a file cannot be written.
+pub fn write(dir: &Path, results: &Results) -> Result<()> {
+    Results::from_value(serde_json::to_value(results)?)?;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let json_path = dir.join("results.json");
-    std::fs::write(&json_path, serde_json::to_string_pretty(&typed)?)
+    std::fs::write(&json_path, serde_json::to_string_pretty(results)?)
         .with_context(|| format!("cannot write {}", json_path.display()))?;
-    let charts = super::charts::write_all(dir, &typed)?;
-    let mut text = report(&typed);
+    let charts = super::charts::write_all(dir, results)?;
+    let mut text = report(results);
     if !charts.is_empty() {
         let _ = writeln!(text, "\n## Charts\n");
         for c in &charts {

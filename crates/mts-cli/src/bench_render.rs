@@ -4,12 +4,13 @@
 
 use super::render::Size;
 use super::MeshSource;
+use crate::results::Scene;
 use anyhow::Result;
 use clap::Args;
 use mts::{peers, Extractor};
 use mts_render::headless::HeadlessTarget;
 use mts_render::{Camera, Gpu, RendererConfig, StripRenderer};
-use serde_json::json;
+use serde::Serialize;
 use std::time::Instant;
 
 #[derive(Args)]
@@ -38,6 +39,37 @@ pub struct BenchRenderArgs {
 /// The scene row skips (with a note) where the scene itself would refuse:
 /// past this many bytes of per-instance coherence caches.
 use mts_render::scene::MAX_CACHE_BYTES as SCENE_MEMORY_CAP;
+
+/// What `--json` prints.
+#[derive(Serialize)]
+struct RenderReport {
+    scene: Option<Scene>,
+    input: String,
+    adapter: String,
+    backend: String,
+    device_type: String,
+    strip_mode: String,
+    width: u32,
+    height: u32,
+    frames: usize,
+    rows: Vec<RenderRow>,
+}
+
+/// One method at one level.
+#[derive(Serialize)]
+struct RenderRow {
+    ratio: f64,
+    lod: usize,
+    triangles: usize,
+    method: &'static str,
+    indices_sent: usize,
+    indices_drawn: usize,
+    ms_per_frame: f64,
+    fps: f64,
+    triangles_per_second: f64,
+    /// `None` for the list, which has no LoD step.
+    lod_step_us: Option<f64>,
+}
 
 /// Median milliseconds of `frames` frames of `renderer` into `target`.
 fn frame_ms(
@@ -133,41 +165,41 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
                     step.map_or(String::new(), |s| format!("{s:.0}"))
                 );
             }
-            rows.push(json!({
-                "ratio": ratio,
-                "lod": lod,
-                "triangles": triangles,
-                "method": method,
-                "indices_sent": indices,
-                "indices_drawn": renderer.indices_drawn(),
-                "ms_per_frame": ms,
-                "fps": fps,
-                "triangles_per_second": triangles as f64 * fps,
-                "lod_step_us": step,
-            }));
+            rows.push(RenderRow {
+                ratio,
+                lod,
+                triangles,
+                method,
+                indices_sent: indices,
+                indices_drawn: renderer.indices_drawn(),
+                ms_per_frame: ms,
+                fps,
+                triangles_per_second: triangles as f64 * fps,
+                lod_step_us: step,
+            });
         }
     }
     let scene = if args.scene > 0 {
-        bench_scene(&gpu, &target, &config, &model, args)?
+        bench_scene(&gpu, &target, &config, &name, &model, args)?
     } else {
         None
     };
     if args.json {
-        println!(
-            "{}",
-            json!({
-                "scene": scene,
-                "input": name,
-                "adapter": report.name,
-                "backend": format!("{:?}", report.backend),
-                "device_type": format!("{:?}", report.device_type),
-                "strip_mode": report.strip_mode.to_string(),
-                "width": args.size.0,
-                "height": args.size.1,
-                "frames": args.frames,
-                "rows": rows,
-            })
-        );
+        let out = RenderReport {
+            scene,
+            input: name,
+            adapter: report.name,
+            backend: format!("{:?}", report.backend),
+            device_type: format!("{:?}", report.device_type),
+            strip_mode: report.strip_mode.to_string(),
+            width: args.size.0,
+            height: args.size.1,
+            frames: args.frames,
+            rows,
+        };
+        // Through a `Value`, whose keys are sorted: the order this output
+        // has always had.
+        println!("{}", serde_json::to_value(out)?);
     }
     Ok(())
 }
@@ -180,39 +212,42 @@ fn bench_scene(
     gpu: &Gpu,
     target: &HeadlessTarget,
     config: &RendererConfig,
+    name: &str,
     model: &mts::MtsModel,
     args: &BenchRenderArgs,
-) -> Result<Option<serde_json::Value>> {
-    let row = scene_row(gpu, target, config, model, args.scene, args.frames)?;
+) -> Result<Option<Scene>> {
+    let row = scene_row(gpu, target, config, name, model, args.scene, args.frames)?;
     if let (Some(r), false) = (&row, args.json) {
-        let ms = r["ms_per_frame"].as_f64().unwrap_or(f64::NAN);
+        let ms = r.ms_per_frame;
         println!(
             "scene: {} instances, {} visible, {} triangles, {} indices sent; \
              first update {:.1} ms; frame {ms:.2} ms = {:.1} fps, {:.2} Mtri/s",
             args.scene,
-            r["visible"],
-            r["triangles"],
-            r["indices_sent"],
-            r["ms_first_update"].as_f64().unwrap_or(f64::NAN),
+            r.visible,
+            r.triangles,
+            r.indices_sent,
+            r.ms_first_update,
             1e3 / ms,
-            r["triangles_per_second"].as_f64().unwrap_or(f64::NAN) / 1e6,
+            r.triangles_per_second / 1e6,
         );
     }
     Ok(row)
 }
 
 /// Median frame (every instance's LoD update and the draw) of `instances`
-/// copies of `model` seen by the scene's overview camera, `frames` timed
-/// frames after two warm-up ones. `None` (with a note on stderr) when the
-/// instances' coherence caches would exceed [`SCENE_MEMORY_CAP`].
+/// copies of `model` (called `name`) seen by the scene's overview camera,
+/// `frames` timed frames after two warm-up ones. `None` (with a note on
+/// stderr) when the instances' coherence caches would exceed
+/// [`SCENE_MEMORY_CAP`].
 pub fn scene_row(
     gpu: &Gpu,
     target: &HeadlessTarget,
     config: &RendererConfig,
+    name: &str,
     model: &mts::MtsModel,
     instances: usize,
     frames: usize,
-) -> Result<Option<serde_json::Value>> {
+) -> Result<Option<Scene>> {
     use crate::demo_scene::DemoScene;
     let per_instance = 4 * Extractor::new(model).buffer().len();
     if per_instance.saturating_mul(instances) > SCENE_MEMORY_CAP {
@@ -241,17 +276,18 @@ pub fn scene_row(
     }
     times.sort_by(f64::total_cmp);
     let ms = times[times.len() / 2];
-    Ok(Some(json!({
-        "instances": instances,
-        "width": width,
-        "height": height,
-        "visible": stats.visible,
-        "triangles": stats.triangles,
-        "indices_sent": stats.indices_sent,
-        "cpu_bytes_per_instance": per_instance,
-        "ms_first_update": first_ms,
-        "ms_per_frame": ms,
-        "fps": 1e3 / ms,
-        "triangles_per_second": stats.triangles as f64 * 1e3 / ms,
-    })))
+    Ok(Some(Scene {
+        model: name.to_string(),
+        instances: instances as u64,
+        width,
+        height,
+        visible: stats.visible as u64,
+        triangles: stats.triangles as u64,
+        indices_sent: stats.indices_sent as u64,
+        cpu_bytes_per_instance: per_instance as u64,
+        ms_first_update: first_ms,
+        ms_per_frame: ms,
+        fps: 1e3 / ms,
+        triangles_per_second: stats.triangles as f64 * 1e3 / ms,
+    }))
 }

@@ -68,17 +68,16 @@ pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result
         "{:>6} {:>9} {:>12} {:>12} {:>14} {:>10} {:>12}",
         "share", "triangles", "MTS strips", "tri. list", "meshopt strips", "MTS/list", "extract us"
     );
-    for l in levels.as_array().into_iter().flatten() {
-        let g = |k: &str| l[k].as_f64().unwrap_or(f64::NAN);
+    for l in &levels {
         println!(
-            "{:>5.0}% {:>9.0} {:>12.0} {:>12.0} {:>14.0} {:>10.3} {:>12.1}",
-            g("share") * 100.0,
-            g("triangles"),
-            g("mts_indices"),
-            g("list_indices"),
-            g("meshopt_strip_indices"),
-            g("mts_indices") / g("list_indices"),
-            g("extract_us"),
+            "{:>5.0}% {:>9} {:>12} {:>12} {:>14} {:>10.3} {:>12.1}",
+            l.share * 100.0,
+            l.triangles,
+            l.mts_indices,
+            l.list_indices,
+            l.meshopt_strip_indices,
+            l.mts_indices as f64 / l.list_indices as f64,
+            l.extract_us,
         );
     }
     match render_thumbnails(&model, thumbnails) {

@@ -23,11 +23,11 @@
 //! cost `e` ms and drawing cost `d` ms, a second holds `1 + (1000 − e) / d`
 //! frames.
 
+use crate::results::{Figure6, Figure6Row, Scene};
 use anyhow::Result;
 use mts::{peers, Extractor, MtsModel};
 use mts_render::headless::HeadlessTarget;
 use mts_render::{Camera, Gpu, RendererConfig, StripRenderer};
-use serde_json::{json, Value};
 use std::time::Instant;
 
 /// Image size of the frames.
@@ -77,7 +77,7 @@ impl Renderer {
         input: &mts::Mesh,
         shares: &[f64],
         frames: usize,
-    ) -> Result<Value> {
+    ) -> Result<Figure6> {
         let (d, q) = (&self.gpu.device, &self.gpu.queue);
         let camera = Camera::framing_points(model.positions(), self.target.aspect());
         let mut strips = StripRenderer::for_model(d, q, &self.config, model)?;
@@ -184,17 +184,17 @@ impl Renderer {
                     None,
                 ),
             ] {
-                rows.push(json!({
-                    "share": share,
-                    "lod": lod,
-                    "triangles": triangles,
-                    "method": method,
-                    "mode": mode,
-                    "indices_sent": indices,
-                    "fps": fps,
-                    "draw_ms": draw_ms,
-                    "change_us": change_us,
-                }));
+                rows.push(Figure6Row {
+                    method: method.into(),
+                    mode: mode.into(),
+                    share,
+                    lod: lod as u64,
+                    triangles: triangles as u64,
+                    indices_sent: indices as u64,
+                    draw_ms,
+                    fps,
+                    change_us,
+                });
             }
         }
         for method in [
@@ -205,26 +205,33 @@ impl Renderer {
         ] {
             self.measure_source(method, model, input, shares, frames, &camera, &mut rows)?;
         }
-        Ok(json!({ "width": WIDTH, "height": HEIGHT, "frames": frames, "rows": rows }))
+        Ok(Figure6 {
+            width: WIDTH,
+            height: HEIGHT,
+            frames: frames as u64,
+            rows,
+        })
     }
 
     /// The scene row (see `mts bench render`) for `instances` copies of
-    /// `model`, `frames` timed frames.
+    /// `model` (called `name`), `frames` timed frames; `None` where the
+    /// instances' coherence caches would exceed the scene's cap.
     pub fn measure_scene(
         &self,
+        name: &str,
         model: &MtsModel,
         instances: usize,
         frames: usize,
-    ) -> Result<Value> {
-        let row = super::bench_render::scene_row(
+    ) -> Result<Option<Scene>> {
+        super::bench_render::scene_row(
             &self.gpu,
             &self.target,
             &self.config,
+            name,
             model,
             instances,
             frames,
-        )?;
-        Ok(row.unwrap_or(Value::Null))
+        )
     }
 
     /// Figure 6 rows of one baseline (see the module documentation).
@@ -237,7 +244,7 @@ impl Renderer {
         shares: &[f64],
         frames: usize,
         camera: &Camera,
-        rows: &mut Vec<Value>,
+        rows: &mut Vec<Figure6Row>,
     ) -> Result<()> {
         let (d, q) = (&self.gpu.device, &self.gpu.queue);
         let mut source = super::make_source(method, model, input)?;
@@ -281,17 +288,17 @@ impl Renderer {
                 ("immediate", 1e3 / median(immediate.clone())),
                 ("per_second", per_second),
             ] {
-                rows.push(json!({
-                    "share": share,
-                    "lod": lod,
-                    "triangles": triangles,
-                    "method": source.name(),
-                    "mode": mode,
-                    "indices_sent": source.indices().len(),
-                    "fps": fps,
-                    "draw_ms": draw_ms,
-                    "change_us": null,
-                }));
+                rows.push(Figure6Row {
+                    method: source.name().into(),
+                    mode: mode.into(),
+                    share,
+                    lod: lod as u64,
+                    triangles: triangles as u64,
+                    indices_sent: source.indices().len() as u64,
+                    draw_ms,
+                    fps,
+                    change_us: None,
+                });
             }
         }
         Ok(())

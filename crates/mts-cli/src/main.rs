@@ -7,7 +7,9 @@ use mts::mesh::io::{load, LoadOptions};
 use mts::mesh::{CleanOptions, CleanReport, Mesh};
 use mts::strip::stats::StripStats;
 use mts::{peers, stripify, StripifyOptions};
+use results::MethodRow;
 use serde_json::json;
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -255,10 +257,9 @@ fn bench_cmd(args: &BenchArgs) -> Result<()> {
         command: std::env::args().collect::<Vec<_>>().join(" "),
         render: !args.no_render,
     };
-    let mut results = bench::run(&options, &|what| {
+    let results = bench::run(&options, &|what| {
         bar.set_message(format!("measuring {what}"))
     })?;
-    results["elapsed_s"] = json!(t.elapsed().as_secs_f64());
     bar.finish_and_clear();
     bench::write(&args.out, &results)?;
     println!(
@@ -569,16 +570,9 @@ fn median_ms<T>(repeat: usize, mut f: impl FnMut() -> T) -> (T, f64) {
     (out.expect("at least one run"), times[times.len() / 2])
 }
 
+/// `mts strips --json`'s figures of one stripifier: the bench's row.
 fn stats_json(s: &StripStats) -> serde_json::Value {
-    json!({
-        "triangles": s.triangles,
-        "strips": s.strips,
-        "swaps": s.swaps,
-        "indices_restart": s.indices_restart,
-        "indices_per_triangle": s.indices_per_triangle,
-        "acmr": s.acmr,
-        "ms": s.ms,
-    })
+    json!(results::StripRow::from(s))
 }
 
 fn strips(args: &StripsArgs) -> Result<()> {
@@ -666,7 +660,8 @@ fn strips(args: &StripsArgs) -> Result<()> {
 }
 
 fn simplify(args: &SimplifyArgs) -> Result<()> {
-    use mts::distance::{surface_distance, Surface};
+    use mts::distance::surface_distance;
+    use mts::peers::quality::{self, Measurement};
     use mts::simplify::{Placement, SimplifyOptions};
     let (name, mesh, _) = args.source.load()?;
     let input = mesh.triangle_count();
@@ -704,46 +699,46 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
     let partial = mts::simplify(&mesh, &options);
     let ms_to_target = t.elapsed().as_secs_f64() * 1e3;
     let collapses = &whole.collapses;
-    let mut lod = collapses.lod_for_triangles(target);
+    let lod = collapses.lod_for_triangles(target);
     // The early-stopped run must be a prefix of the whole sequence.
     if partial.collapses.steps() != &collapses.steps()[..partial.collapses.max_lod()] {
         bail!("internal error: the sequence stopped at the target differs from the whole one");
     }
-    // Compare at one triangle count: ours at the target, meshoptimizer
-    // asked for the same; when it stops above it, ours at its count.
-    let mut peer_triangles = None;
     let skipped = peers::meshopt::refusal(&mesh);
     if let Some(why) = &skipped {
         eprintln!("{name}: {why}");
     }
-    if !args.no_meshopt && skipped.is_none() {
-        let ((theirs, at), their_ms) =
-            median_ms(1, || peers::meshopt::simplify_to_lod(&mesh, collapses, lod));
-        lod = at;
-        peer_triangles = Some((theirs, their_ms));
-    }
-    let triangles = collapses.triangles_at(&mesh, lod);
-    let positions: Vec<glam::Vec3> = mesh
-        .positions
-        .iter()
-        .chain(collapses.appended())
-        .copied()
-        .collect();
-    let ours = Surface {
-        positions: &positions,
-        triangles: &triangles,
+    // Our LoD over every input and appended position, referenced or not:
+    // the surface `mts simplify` has always measured (the bench drops the
+    // unreferenced ones, and both keep their own figures).
+    let ours_at = |lod| Mesh {
+        positions: mesh
+            .positions
+            .iter()
+            .chain(collapses.appended())
+            .copied()
+            .collect(),
+        triangles: collapses.triangles_at(&mesh, lod),
     };
-    let d = surface_distance((&mesh).into(), ours, args.samples);
-    let mut peer = serde_json::Value::Null;
-    if let Some((theirs, their_ms)) = peer_triangles {
-        let td = surface_distance((&mesh).into(), Surface::over(&mesh, &theirs), args.samples);
-        peer = json!({
-            "triangles": theirs.len(),
-            "ms": their_ms,
-            "hausdorff": td.hausdorff,
-            "rms": td.rms,
+    // Compare at one triangle count: ours at the target, meshoptimizer
+    // asked for the same; when it stops above it, ours at its count.
+    let (lod, d, peer) = if !args.no_meshopt && skipped.is_none() {
+        let q = quality::compare(&mesh, collapses, lod, args.samples, ours_at);
+        let peer = json!({
+            "triangles": q.meshopt.triangle_count,
+            "ms": q.meshopt_ms,
+            "hausdorff": q.meshopt.distance.hausdorff,
+            "rms": q.meshopt.distance.rms,
         });
-    }
+        (q.lod, q.ours, peer)
+    } else {
+        let ours = ours_at(lod);
+        let d = Measurement {
+            triangle_count: ours.triangle_count(),
+            distance: surface_distance((&mesh).into(), (&ours).into(), args.samples),
+        };
+        (lod, d, serde_json::Value::Null)
+    };
     if let Some(path) = &args.output {
         mts::mesh::io::save_obj(&collapses.mesh_at(&mesh, lod), path)?;
     }
@@ -751,14 +746,14 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
         "mesh": name,
         "input_triangles": input,
         "target": target,
-        "triangles": triangles.len(),
+        "triangles": d.triangle_count,
         "lod": lod,
         "max_lod": collapses.max_lod(),
         "ms": ms,
         "ms_to_target": ms_to_target,
         "quadric_error": collapses.error(lod),
-        "hausdorff": d.hausdorff,
-        "rms": d.rms,
+        "hausdorff": d.distance.hausdorff,
+        "rms": d.distance.rms,
         "stop": whole.stop.to_string(),
         "meshopt": peer,
     });
@@ -1503,14 +1498,17 @@ fn measure_methods(
     mesh: &Mesh,
     mts_ms: f64,
     requests: usize,
-) -> Result<Vec<serde_json::Value>> {
+) -> Result<Vec<MethodRow>> {
     use mts::model::sequence;
     let raw = mesh.raw_bytes_u16();
     let mut rows = Vec::new();
     for method in Method::ALL {
         if method == Method::Discrete {
             if let Some(why) = peers::meshopt::refusal(mesh) {
-                rows.push(json!({"method": "discrete", "skipped": why}));
+                rows.push(MethodRow::Skipped {
+                    method: "discrete".into(),
+                    skipped: why,
+                });
                 continue;
             }
         }
@@ -1525,7 +1523,7 @@ fn measure_methods(
             .map(|l| source.triangle_count(l) as u32)
             .collect();
         let sequences = sequence::table2(&counts, requests);
-        let mut us = serde_json::Map::new();
+        let mut us = BTreeMap::new();
         for (label, lods) in &sequences {
             source.set_lod(max_lod);
             let t = Instant::now();
@@ -1533,16 +1531,16 @@ fn measure_methods(
                 source.set_lod(l);
             }
             let per = t.elapsed().as_secs_f64() * 1e6 / lods.len().max(1) as f64;
-            us.insert((*label).to_string(), json!(per));
+            us.insert((*label).to_string(), per);
         }
         let file = source.file_bytes();
-        rows.push(json!({
-            "method": source.name(),
-            "build_ms": build_ms,
-            "memory_bytes": source.memory_bytes(),
-            "file_bytes": file,
-            "file_ratio_to_raw_u16": file as f64 / raw as f64,
-            "us_per_change": us,
+        rows.push(MethodRow::Measured(results::Method {
+            method: source.name().to_string(),
+            build_ms,
+            memory_bytes: source.memory_bytes() as u64,
+            file_bytes: file as u64,
+            file_ratio_to_raw_u16: file as f64 / raw as f64,
+            us_per_change: us,
         }));
     }
     Ok(rows)
@@ -1577,21 +1575,24 @@ fn compare(args: &CompareArgs) -> Result<()> {
         "method", "build ms", "memory B", "file B", "/raw", "us lin", "us exp", "us rand"
     );
     for r in &rows {
-        if let Some(why) = r["skipped"].as_str() {
-            println!("{:<12}{why}", r["method"].as_str().unwrap_or(""));
-            continue;
-        }
-        let f = |v: &serde_json::Value| v.as_f64().unwrap_or(0.0);
+        let r = match r {
+            MethodRow::Measured(r) => r,
+            MethodRow::Skipped { method, skipped } => {
+                println!("{method:<12}{skipped}");
+                continue;
+            }
+        };
+        let us = |seq: &str| r.us_per_change.get(seq).copied().unwrap_or(0.0);
         println!(
             "{:<12}{:>10.1}{:>12}{:>12}{:>8.3}{:>10.1}{:>10.1}{:>10.1}",
-            r["method"].as_str().unwrap_or(""),
-            f(&r["build_ms"]),
-            r["memory_bytes"].as_u64().unwrap_or(0),
-            r["file_bytes"].as_u64().unwrap_or(0),
-            f(&r["file_ratio_to_raw_u16"]),
-            f(&r["us_per_change"]["linear"]),
-            f(&r["us_per_change"]["exponential"]),
-            f(&r["us_per_change"]["random"]),
+            r.method,
+            r.build_ms,
+            r.memory_bytes,
+            r.file_bytes,
+            r.file_ratio_to_raw_u16,
+            us("linear"),
+            us("exponential"),
+            us("random"),
         );
     }
     Ok(())

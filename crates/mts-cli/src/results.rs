@@ -89,6 +89,20 @@ pub struct StripRow {
     pub ms: f64,
 }
 
+impl From<&mts::strip::stats::StripStats> for StripRow {
+    fn from(s: &mts::strip::stats::StripStats) -> StripRow {
+        StripRow {
+            triangles: s.triangles as u64,
+            strips: s.strips as u64,
+            swaps: s.swaps as u64,
+            indices_restart: s.indices_restart as u64,
+            indices_per_triangle: s.indices_per_triangle,
+            acmr: s.acmr,
+            ms: s.ms,
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Stripify {

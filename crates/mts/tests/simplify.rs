@@ -471,17 +471,49 @@ fn non_manifold_models_against_meshoptimizer() {
 
 /// Our LoD at `ratio` and meshoptimizer's `simplify` at its triangle count,
 /// measured against `mesh` (50,000 samples a side), as the bench report
-/// compares them (`peers::meshopt::simplify_to_lod`: where meshoptimizer
-/// stops above our count, our LoD at its count); and our triangle count.
+/// compares them (`peers::quality::compare`: where meshoptimizer stops
+/// above our count, our LoD at its count); and our triangle count.
 fn against_meshoptimizer(
     mesh: &Mesh,
     c: &Collapses,
     ratio: f64,
 ) -> (SurfaceDistance, SurfaceDistance, usize) {
-    let (theirs, lod) = peers::meshopt::simplify_to_lod(mesh, c, c.lod_for_ratio(ratio));
-    let ours = c.triangles_at(mesh, lod);
-    let measure = |t: &[[u32; 3]]| surface_distance(mesh.into(), Surface::over(mesh, t), 50_000);
-    (measure(&ours), measure(&theirs), ours.len())
+    let q = peers::quality::compare(mesh, c, c.lod_for_ratio(ratio), 50_000, |lod| Mesh {
+        positions: mesh.positions.clone(),
+        triangles: c.triangles_at(mesh, lod),
+    });
+    (q.ours.distance, q.meshopt.distance, q.ours.triangle_count)
+}
+
+/// The comparison is meshoptimizer's `simplify_to_lod` and the two
+/// distances a caller would measure by hand, at the LoD it reports (on
+/// this torus, meshoptimizer reaches the count asked for: the LoD stays).
+#[test]
+fn quality_comparison_is_both_measurements_at_one_lod() {
+    let mesh: Mesh = "torus:5k"
+        .parse::<mts::mesh::generate::Generated>()
+        .unwrap()
+        .build();
+    let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
+    let asked = c.lod_for_ratio(0.1);
+    let q = peers::quality::compare(&mesh, &c, asked, 5_000, |lod| c.mesh_at(&mesh, lod));
+    let (theirs, lod) = peers::meshopt::simplify_to_lod(&mesh, &c, asked);
+    let ours = c.mesh_at(&mesh, lod);
+    assert_eq!((asked, q.lod, lod), (2205, 2205, 2205));
+    assert_eq!(
+        (q.ours.triangle_count, q.meshopt.triangle_count),
+        (490, 490)
+    );
+    assert_eq!(theirs.len(), 490);
+    assert_eq!(
+        q.ours.distance,
+        surface_distance((&mesh).into(), (&ours).into(), 5_000)
+    );
+    assert_eq!(
+        q.meshopt.distance,
+        surface_distance((&mesh).into(), Surface::over(&mesh, &theirs), 5_000)
+    );
+    assert!(q.meshopt_ms > 0.0);
 }
 
 #[test]

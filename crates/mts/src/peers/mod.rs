@@ -1,3 +1,4 @@
 //! Other people's implementations that `mts` is measured against.
 
 pub mod meshopt;
+pub mod quality;
