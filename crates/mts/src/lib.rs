@@ -8,7 +8,8 @@
 //! only the strips that changed. See `ARCHITECTURE.md` and
 //! `../shared/DESIGN.md`. The wgpu renderer is the crate `mts-render`; this
 //! crate has no GPU, no CLI and, by default, no C++ peer (feature `peers`:
-//! meshoptimizer, and the discrete-LoD baseline made from it). The methods
+//! meshoptimizer, and the discrete-LoD baseline made from it) and no glTF
+//! (feature `gltf`: [`mesh::io`] reads and writes `.gltf`/`.glb`). The methods
 //! MTS is measured against ([`baselines`]: progressive mesh,
 //! progressive multilevel mesh, cluster tree with its packet stream,
 //! discrete LoDs) and MTS itself share one interface, [`LodSource`].

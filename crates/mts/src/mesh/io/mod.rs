@@ -1,12 +1,21 @@
-//! Reading meshes from files: OBJ and PLY, each with its own reader.
+//! Reading meshes from files: OBJ and PLY, each with its own reader, and
+//! glTF 2.0 (`.gltf`, `.glb`; reader and writer) behind the feature `gltf`.
 //!
 //! Every loader returns a [`RawMesh`] whose positions are finite and whose
 //! indices are in range, or an error naming the file and the place; [`load`]
 //! then cleans it (see [`crate::mesh::clean`]).
 
+#[cfg(feature = "gltf")]
+mod gltf;
+#[cfg(feature = "gltf")]
+mod gltf_write;
 mod obj;
 mod ply;
 
+#[cfg(feature = "gltf")]
+pub use gltf::{parse_gltf, MAX_INSTANCED};
+#[cfg(feature = "gltf")]
+pub use gltf_write::save_gltf;
 pub use obj::{parse_obj, parse_obj_with};
 pub use ply::parse_ply;
 
@@ -58,11 +67,15 @@ pub enum Format {
     Obj,
     /// Stanford PLY, ascii or binary.
     Ply,
+    /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
+    #[cfg(feature = "gltf")]
+    Gltf,
 }
 
 impl Format {
     /// Picks the format from the file extension, then from the content
-    /// (`ply` magic line; `v `/`f `/`o `/`#` lines for OBJ).
+    /// (`ply` magic line; with the feature `gltf`, the GLB magic `glTF`;
+    /// `v `/`f `/`o `/`#` lines for OBJ).
     ///
     /// # Errors
     /// [`Error::UnknownFormat`] when neither tells.
@@ -74,10 +87,16 @@ impl Format {
         match ext.as_deref() {
             Some("obj") => return Ok(Format::Obj),
             Some("ply") => return Ok(Format::Ply),
+            #[cfg(feature = "gltf")]
+            Some("gltf" | "glb") => return Ok(Format::Gltf),
             _ => {}
         }
         if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
             return Ok(Format::Ply);
+        }
+        #[cfg(feature = "gltf")]
+        if bytes.starts_with(b"glTF") {
+            return Ok(Format::Gltf);
         }
         let head = &bytes[..bytes.len().min(4096)];
         if let Ok(text) = std::str::from_utf8(head) {
@@ -91,10 +110,15 @@ impl Format {
         }
         Err(Error::UnknownFormat {
             file: path.to_owned(),
-            message:
+            message: if cfg!(feature = "gltf") {
+                "expected a .obj, .ply, .gltf or .glb file (no extension matched, and from byte 0 \
+                 the content starts with neither a `ply` line, the GLB magic `glTF`, nor OBJ \
+                 statements)"
+            } else {
                 "expected a .obj or .ply file (no extension matched, and from byte 0 the content \
-                      starts with neither a `ply` line nor OBJ statements)"
-                    .into(),
+                 starts with neither a `ply` line nor OBJ statements)"
+            }
+            .into(),
         })
     }
 }
@@ -155,18 +179,22 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// Parses mesh bytes in the given format; `path` names the input in errors.
+/// Parses mesh bytes in the given format; `path` names the input in errors
+/// (and, for glTF, is the folder external buffers are read from).
 ///
 /// # Errors
-/// As [`parse_obj`] and [`parse_ply`].
+/// As [`parse_obj`], [`parse_ply`] and `parse_gltf`.
 pub fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<RawMesh> {
     match format {
         Format::Obj => parse_obj(bytes, path),
         Format::Ply => parse_ply(bytes, path),
+        #[cfg(feature = "gltf")]
+        Format::Gltf => parse_gltf(bytes, path),
     }
 }
 
-/// Loads and cleans a mesh file (OBJ or PLY, detected by [`Format::detect`]).
+/// Loads and cleans a mesh file (OBJ, PLY or, with the feature `gltf`,
+/// glTF; detected by [`Format::detect`]).
 ///
 /// # Errors
 /// [`Error::Io`], [`Error::UnknownFormat`], [`Error::Parse`] with the place

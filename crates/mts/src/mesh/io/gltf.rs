@@ -1,0 +1,1211 @@
+//! glTF 2.0 reader: `.gltf` (JSON, buffers as data URIs or files beside it)
+//! and `.glb` (binary container), behind the feature `gltf`. The writer is
+//! [`super::save_gltf`].
+//!
+//! Follows the glTF 2.0 specification (Khronos, version 2.0.1), its
+//! sections on scenes and node transformations, binary data storage
+//! (buffers, buffer views, accessors), meshes (primitive topology),
+//! materials, and the GLB file format.
+//!
+//! What is read: every primitive of every mesh reached from the default
+//! scene (else scene 0; without scenes, from every root node; without
+//! nodes, every mesh untransformed), each under its node's world matrix
+//! (positions by the matrix, normals by its inverse transpose then
+//! normalised, winding flipped where the determinant is negative).
+//! Attributes `POSITION`, `NORMAL`, `TEXCOORD_0` (`v` flipped to point up
+//! the image: `v = 1 - v_gltf`), `COLOR_0` (vec3 or vec4, float or
+//! normalised integers; vec3 gets alpha 1) and the indices (u8, u16, u32, or
+//! none: vertices in order). Triangle strips and fans become triangles of
+//! the same winding; points and lines are skipped with a note on stderr.
+//! Not read: skins, morph targets, animations, cameras, texture sets other
+//! than 0, tangents, textures other than the base colour.
+//!
+//! **Primitives with different materials become one mesh.** The pipeline
+//! simplifies and stripifies one surface, and a [`RawMesh`] has no
+//! per-triangle material: splitting by material would give several meshes
+//! whose shared borders the simplifier could no longer keep closed, and a
+//! per-material option would reach every stage for a case the models at
+//! hand do not have. What is kept of the materials: the base-colour texture
+//! of the first primitive (in scene order) whose material has one, with a
+//! note when another primitive samples a different image; and each
+//! material's base-colour factor, multiplied into the vertex colours when
+//! some factor is not white, so parts told apart by a flat colour stay
+//! apart. Cost: a model with several textures (an atlas per part) is drawn
+//! with the first one only.
+//!
+//! **Attributes only some primitives have** are filled for the others with
+//! a neutral value: normal zero (no normal, computed where drawn), texture
+//! coordinate `(0, 0)`, colour white (times the material's factor). A
+//! stream no primitive has stays absent.
+//!
+//! **Checks.** Every index followed (scene, node, mesh, accessor, buffer
+//! view, buffer, material, texture, image) is checked before use, so the
+//! `gltf` crate's own `validate`, whose primitive hook indexes the accessor
+//! list before the range is checked (a panic on a bad `POSITION` index), is
+//! not called. Accessor ranges (`offset + stride * (count - 1) + element`)
+//! are checked against their buffer view and views against their buffer
+//! before anything is allocated; index values against the primitive's
+//! vertex count; floats for finiteness; GLB chunks against the file length;
+//! data URIs for base64. Sparse accessors and accessors without a buffer
+//! view (all zeros) are refused. Node hierarchies must be trees (a node
+//! reached twice is an error, so cycles end), walked without recursion. All
+//! instances together may hold at most [`MAX_INSTANCED`] vertices and as
+//! many triangles. Errors are [`Error::Parse`] naming the glTF file and the
+//! JSON object (`accessor 3`, `node 2`, `mesh 0 primitive 1`); `byte` is an
+//! offset in that file when the data lies in it (the BIN chunk of a
+//! `.glb`), and for data in a `.bin` file or a data URI the message gives
+//! the buffer and its offset. An external buffer that cannot be read is
+//! [`Error::Io`] naming that file.
+//!
+//! Position ids are left empty: glTF has no notion of one point split at a
+//! seam (vertices are split per primitive and per attribute value alike);
+//! [`crate::mesh::CleanOptions::weld`] merges bit-identical positions.
+
+use super::read_file;
+use crate::error::{Error, Place, Result};
+use crate::mesh::{RawMesh, Texture};
+use glam::{DMat3, DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
+use gltf::json;
+use gltf::json::accessor::{ComponentType, Type};
+use gltf::json::mesh::{Mode, Semantic};
+use gltf::json::validation::Checked;
+use std::borrow::Cow;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+/// Most vertices (and, separately, triangles) all instances of all meshes
+/// may add up to: as many positions as the largest file the readers accept
+/// ([`super::MAX_FILE_BYTES`]) holds at 12 bytes each. Without instancing
+/// no file reaches it; the cap stops a small file that places a large mesh
+/// under thousands of nodes from asking for terabytes.
+pub const MAX_INSTANCED: u64 = super::MAX_FILE_BYTES / 12;
+
+/// Extensions a file may require that this reader honours: quantized
+/// attributes are read through the generic component decoding, and unlit
+/// materials change no geometry or texture.
+const SUPPORTED_REQUIRED: &[&str] = &["KHR_mesh_quantization", "KHR_materials_unlit"];
+
+/// Parses a `.gltf` or `.glb` file (told apart by the GLB magic `glTF`)
+/// into one [`RawMesh`], as described in the module docs. External buffers
+/// are read with [`read_file`] relative to `path`'s folder; an external
+/// base-colour image is only named ([`Texture::File`]), not read.
+///
+/// # Errors
+/// [`Error::Parse`] with the JSON object (and the byte, for GLB data) at
+/// fault; [`Error::Io`] for an external buffer that cannot be read.
+///
+/// Cost: O(file size + output) time; the output and the external buffers
+/// are held in memory, nothing is allocated beyond what the checked counts
+/// and the buffers bound.
+pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<RawMesh> {
+    let (text, bin) = if bytes.starts_with(b"glTF") {
+        split_glb(bytes, path)?
+    } else {
+        (bytes, None)
+    };
+    let root: json::Root = json::deserialize::from_slice(text).map_err(|e| Error::Parse {
+        file: path.to_owned(),
+        place: Place::line(e.line() as u64),
+        message: format!(
+            "{}not a glTF document: {e}",
+            if bytes.starts_with(b"glTF") {
+                "JSON chunk: "
+            } else {
+                ""
+            }
+        ),
+    })?;
+    let mut reader = Reader {
+        root: &root,
+        path,
+        folder: path.parent().map(Path::to_owned).unwrap_or_default(),
+        bin,
+        buffers: (0..root.buffers.len()).map(|_| None).collect(),
+        raw: RawMesh::default(),
+        base_color: None,
+        factors_used: false,
+        instanced_triangles: 0,
+        notes: HashSet::new(),
+    };
+    reader.check_extensions()?;
+    reader.read_scene()?;
+    reader.finish()
+}
+
+/// The GLB BIN chunk: its bytes and their offset in the file.
+type Bin<'a> = Option<(&'a [u8], u64)>;
+
+/// Splits a GLB file into its JSON chunk and optional BIN chunk, checking
+/// the header and every chunk against the file's length.
+fn split_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<(&'a [u8], Bin<'a>)> {
+    let fail = |byte: usize, element: &str, index: Option<u64>, message: String| Error::Parse {
+        file: path.to_owned(),
+        place: Place {
+            byte: Some(byte as u64),
+            element: Some(element.to_owned()),
+            index,
+            ..Place::default()
+        },
+        message,
+    };
+    let word = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+    };
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        return Err(fail(
+            0,
+            "GLB header",
+            None,
+            format!(
+                "{} bytes, a GLB header has 12: the file is truncated",
+                bytes.len()
+            ),
+        ));
+    };
+    if version != 2 {
+        return Err(fail(
+            4,
+            "GLB header",
+            None,
+            format!("GLB version {version}; only version 2 is read"),
+        ));
+    }
+    let end = (length as usize).min(bytes.len());
+    let (mut at, mut chunk) = (12usize, 0u64);
+    let (mut json, mut bin) = (None, None);
+    while at < end {
+        let (Some(len), Some(kind)) = (word(at), word(at + 4)) else {
+            return Err(fail(
+                at,
+                "GLB chunk",
+                Some(chunk),
+                format!(
+                    "the chunk header runs past the end of the file at byte {}: the file is truncated",
+                    bytes.len()
+                ),
+            ));
+        };
+        let data = at + 8;
+        let Some(data_end) = data.checked_add(len as usize).filter(|&e| e <= bytes.len()) else {
+            return Err(fail(
+                at,
+                "GLB chunk",
+                Some(chunk),
+                format!(
+                    "a chunk of {len} bytes from byte {data} runs past the end of the file at byte {}: the file is truncated",
+                    bytes.len()
+                ),
+            ));
+        };
+        match (&kind.to_le_bytes(), chunk) {
+            (b"JSON", 0) => json = Some(&bytes[data..data_end]),
+            (b"BIN\0", 1) => bin = Some((&bytes[data..data_end], data as u64)),
+            (_, 0) => {
+                return Err(fail(
+                    at,
+                    "GLB chunk",
+                    Some(0),
+                    "the first chunk is not JSON".into(),
+                ))
+            }
+            _ => {} // Chunks of unknown type are skipped (GLB file format: chunks).
+        }
+        at = data_end.next_multiple_of(4);
+        chunk += 1;
+    }
+    if length as usize != bytes.len() {
+        return Err(fail(
+            8,
+            "GLB header",
+            None,
+            format!(
+                "the header says the file has {length} bytes, it has {}{}",
+                bytes.len(),
+                if (length as usize) > bytes.len() {
+                    ": the file is truncated"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    let Some(json) = json else {
+        return Err(fail(12, "GLB chunk", Some(0), "no JSON chunk".into()));
+    };
+    Ok((json, bin))
+}
+
+/// A buffer's bytes and where they came from.
+struct Buffer<'a> {
+    bytes: Cow<'a, [u8]>,
+    /// The file offset of byte 0 when the bytes lie in the parsed file
+    /// (GLB BIN chunk); `None` for a `.bin` file or a data URI.
+    base: Option<u64>,
+    /// Where the bytes came from, for messages.
+    origin: String,
+}
+
+/// An accessor's elements, checked against its buffer.
+struct Elements {
+    ty: ComponentType,
+    normalized: bool,
+    dims: usize,
+    count: usize,
+    /// Byte of element 0 in the buffer.
+    start: usize,
+    stride: usize,
+    buffer: usize,
+}
+
+/// The base-colour texture chosen, and the image it came from.
+struct BaseColor {
+    image: usize,
+    texture: Texture,
+}
+
+/// State of one parse.
+struct Reader<'a> {
+    root: &'a json::Root,
+    path: &'a Path,
+    folder: PathBuf,
+    bin: Bin<'a>,
+    /// Buffers read so far (an unused buffer is never read).
+    buffers: Vec<Option<Buffer<'a>>>,
+    raw: RawMesh,
+    base_color: Option<BaseColor>,
+    /// Whether some material's base-colour factor is not white.
+    factors_used: bool,
+    instanced_triangles: u64,
+    /// Notes printed so far (each once, though a mesh is instanced often).
+    notes: HashSet<String>,
+}
+
+impl<'a> Reader<'a> {
+    fn fail(&self, place: Place, message: String) -> Error {
+        Error::Parse {
+            file: self.path.to_owned(),
+            place,
+            message,
+        }
+    }
+
+    fn note(&mut self, message: String) {
+        if self.notes.insert(message.clone()) {
+            eprintln!("note: {}: {message}", self.path.display());
+        }
+    }
+
+    fn check_extensions(&self) -> Result<()> {
+        for (i, name) in self.root.extensions_required.iter().enumerate() {
+            if !SUPPORTED_REQUIRED.contains(&name.as_str()) {
+                return Err(self.fail(
+                    Place::element("extensionsRequired", i as u64),
+                    format!(
+                        "the file requires the extension {name}, which this reader does not \
+                         support (it supports {})",
+                        SUPPORTED_REQUIRED.join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Walks the scene's node trees depth first, children in order, and
+    /// reads every mesh instance.
+    fn read_scene(&mut self) -> Result<()> {
+        let root = self.root;
+        let node_count = root.nodes.len();
+        let scene = match root.scene {
+            Some(s) => Some((s.value(), Place::element("scene", s.value() as u64))),
+            None if !root.scenes.is_empty() => Some((0, Place::element("scenes", 0))),
+            None => None,
+        };
+        let roots: Vec<usize> = match scene {
+            Some((s, place)) => {
+                let Some(scene) = root.scenes.get(s) else {
+                    return Err(self.fail(
+                        place,
+                        format!("no such scene ({} scenes)", root.scenes.len()),
+                    ));
+                };
+                let mut roots = Vec::with_capacity(scene.nodes.len());
+                for n in &scene.nodes {
+                    if n.value() >= node_count {
+                        return Err(self.fail(
+                            Place::element("scene", s as u64),
+                            format!("node {} does not exist ({node_count} nodes)", n.value()),
+                        ));
+                    }
+                    roots.push(n.value());
+                }
+                roots
+            }
+            None if root.nodes.is_empty() => {
+                for m in 0..root.meshes.len() {
+                    self.read_mesh(m, DMat4::IDENTITY, Place::element("mesh", m as u64))?;
+                }
+                return Ok(());
+            }
+            None => {
+                let mut child = vec![false; node_count];
+                for (n, node) in root.nodes.iter().enumerate() {
+                    for c in node.children.iter().flatten() {
+                        self.check_child(c.value(), n)?;
+                        child[c.value()] = true;
+                    }
+                }
+                (0..node_count).filter(|&n| !child[n]).collect()
+            }
+        };
+        let mut visited = vec![false; node_count];
+        let mut stack: Vec<(usize, DMat4)> =
+            roots.iter().rev().map(|&n| (n, DMat4::IDENTITY)).collect();
+        while let Some((n, parent)) = stack.pop() {
+            let place = Place::element("node", n as u64);
+            if std::mem::replace(&mut visited[n], true) {
+                return Err(self.fail(
+                    place,
+                    "the node is reached twice (glTF nodes form disjoint trees: a node has \
+                     at most one parent and is in one scene root list once)"
+                        .into(),
+                ));
+            }
+            let node = &root.nodes[n];
+            let world = parent * self.local_matrix(node, place.clone())?;
+            if !world.is_finite() {
+                return Err(self.fail(place, "the world transform is not finite".into()));
+            }
+            if let Some(m) = node.mesh {
+                self.read_mesh(m.value(), world, place)?;
+            }
+            for c in node.children.iter().flatten().rev() {
+                self.check_child(c.value(), n)?;
+                stack.push((c.value(), world));
+            }
+        }
+        Ok(())
+    }
+
+    /// An error naming `parent` when its child `child` does not exist.
+    fn check_child(&self, child: usize, parent: usize) -> Result<()> {
+        let count = self.root.nodes.len();
+        if child < count {
+            return Ok(());
+        }
+        Err(self.fail(
+            Place::element("node", parent as u64),
+            format!("child node {child} does not exist ({count} nodes)"),
+        ))
+    }
+
+    /// The node's local matrix: `matrix`, or translation * rotation * scale.
+    fn local_matrix(&self, node: &json::Node, place: Place) -> Result<DMat4> {
+        if let Some(m) = node.matrix {
+            return Ok(DMat4::from_cols_array(&m.map(f64::from)));
+        }
+        let t = node.translation.unwrap_or([0.0; 3]).map(f64::from);
+        let s = node.scale.unwrap_or([1.0; 3]).map(f64::from);
+        let q = node.rotation.unwrap_or_default().0.map(f64::from);
+        let q = DQuat::from_array(q);
+        let len = q.length();
+        if !(len.is_finite() && len > 0.0) {
+            return Err(self.fail(
+                place,
+                format!("rotation {q} is not a rotation (zero or not finite)"),
+            ));
+        }
+        Ok(DMat4::from_scale_rotation_translation(
+            DVec3::from_array(s),
+            q / len,
+            DVec3::from_array(t),
+        ))
+    }
+
+    /// Reads every primitive of mesh `m` under `world`; `place` is the node
+    /// (or mesh) that asked for it.
+    fn read_mesh(&mut self, m: usize, world: DMat4, place: Place) -> Result<()> {
+        let root = self.root;
+        let Some(mesh) = root.meshes.get(m) else {
+            return Err(self.fail(
+                place,
+                format!("mesh {m} does not exist ({} meshes)", root.meshes.len()),
+            ));
+        };
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            self.read_primitive(m, p, primitive, world)?;
+        }
+        Ok(())
+    }
+
+    fn read_primitive(
+        &mut self,
+        m: usize,
+        p: usize,
+        primitive: &json::mesh::Primitive,
+        world: DMat4,
+    ) -> Result<()> {
+        let place = Place::element(&format!("mesh {m} primitive"), p as u64);
+        let Checked::Valid(mode) = primitive.mode else {
+            return Err(self.fail(place, "unknown primitive mode".into()));
+        };
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            let root = self.root;
+            let name = root.meshes[m].name.as_deref().unwrap_or("");
+            self.note(format!(
+                "mesh {m} {name:?} primitive {p} draws {mode:?}, not triangles: skipped"
+            ));
+            return Ok(());
+        }
+        let attribute = |semantic: Semantic| {
+            primitive
+                .attributes
+                .get(&Checked::Valid(semantic))
+                .map(|a| a.value())
+        };
+        let Some(pa) = attribute(Semantic::Positions) else {
+            return Err(self.fail(place, "no POSITION attribute".into()));
+        };
+        let positions = self.elements(pa, &[3], "POSITION", &place)?;
+        let count = positions.count;
+        let before = self.raw.positions.len();
+        if before as u64 + count as u64 > MAX_INSTANCED {
+            return Err(self.fail(
+                place,
+                format!(
+                    "the scene's instances hold more than {MAX_INSTANCED} vertices, the most \
+                     this reader builds"
+                ),
+            ));
+        }
+        let mut streams = [None, None, None];
+        for (slot, (semantic, dims, name)) in [
+            (Semantic::Normals, &[3][..], "NORMAL"),
+            (Semantic::TexCoords(0), &[2][..], "TEXCOORD_0"),
+            (Semantic::Colors(0), &[3, 4][..], "COLOR_0"),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if let Some(a) = attribute(semantic) {
+                let e = self.elements(a, dims, name, &place)?;
+                if e.count != count {
+                    return Err(self.fail(
+                        place,
+                        format!(
+                            "{name} (accessor {a}) has {} elements, POSITION (accessor {pa}) {count}",
+                            e.count
+                        ),
+                    ));
+                }
+                streams[slot] = Some((self.floats(a, &e)?, e.dims));
+            }
+        }
+        let indices = match primitive.indices {
+            Some(a) => self.indices(a.value(), count, &place)?,
+            None => (0..count as u32).collect(),
+        };
+        let triangles = self.triangles(mode, &indices, &place)?;
+        self.instanced_triangles += triangles.len() as u64;
+        if self.instanced_triangles > MAX_INSTANCED {
+            return Err(self.fail(
+                place,
+                format!(
+                    "the scene's instances hold more than {MAX_INSTANCED} triangles, the most \
+                     this reader builds"
+                ),
+            ));
+        }
+        let factor = self.read_material(primitive, &place, streams[1].is_some())?;
+        let positions = self.floats(pa, &positions)?;
+
+        // Transform and append.
+        let identity = world == DMat4::IDENTITY;
+        let linear = DMat3::from_mat4(world);
+        let (a, b, c) = (linear.x_axis, linear.y_axis, linear.z_axis);
+        let det = linear.determinant();
+        // The inverse transpose up to a positive factor: the cofactor
+        // matrix times the determinant's sign (defined even when singular).
+        let cofactor = DMat3::from_cols(b.cross(c), c.cross(a), a.cross(b)) * det.signum();
+        for (v, p) in positions.chunks_exact(3).enumerate() {
+            let p = Vec3::from_slice(p);
+            let q = if identity {
+                p
+            } else {
+                world.transform_point3(p.as_dvec3()).as_vec3()
+            };
+            if !q.is_finite() {
+                return Err(self.fail(
+                    place,
+                    format!("vertex {v} is not finite once transformed ({p} to {q})"),
+                ));
+            }
+            self.raw.positions.push(q);
+        }
+        let [normals, uvs, colors] = streams;
+        let properties = &mut self.raw.properties;
+        let normals = normals.map(|(n, _)| {
+            n.chunks_exact(3)
+                .map(|n| {
+                    let n = Vec3::from_slice(n);
+                    if identity {
+                        n
+                    } else {
+                        (cofactor * n.as_dvec3()).normalize_or_zero().as_vec3()
+                    }
+                })
+                .collect::<Vec<_>>()
+        });
+        extend(&mut properties.normals, before, count, normals, Vec3::ZERO);
+        let uvs = uvs.map(|(t, _)| {
+            t.chunks_exact(2)
+                .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+                .collect::<Vec<_>>()
+        });
+        extend(&mut properties.uvs, before, count, uvs, Vec2::ZERO);
+        let colors = match colors {
+            Some((c, dims)) => Some(
+                c.chunks_exact(dims)
+                    .map(|c| {
+                        let alpha = if dims == 4 { c[3] } else { 1.0 };
+                        Vec4::new(c[0], c[1], c[2], alpha) * factor
+                    })
+                    .collect::<Vec<_>>(),
+            ),
+            None if self.factors_used => Some(vec![factor; count]),
+            None => None,
+        };
+        extend(&mut properties.colors, before, count, colors, Vec4::ONE);
+        let base = before as u32;
+        let flip = det < 0.0;
+        self.raw.triangles.extend(triangles.iter().map(|t| {
+            let t = t.map(|v| v + base);
+            if flip {
+                [t[0], t[2], t[1]]
+            } else {
+                t
+            }
+        }));
+        Ok(())
+    }
+
+    /// The primitive's triangles from its index list, by mode (the
+    /// specification's topology types): strip triangle `i` is
+    /// `(i, i + 1 + i % 2, i + 2 - i % 2)`, fan triangle `i` is
+    /// `(i + 1, i + 2, 0)`. Degenerate strip and fan triangles (a strip's
+    /// joins) are counted in [`RawMesh::degenerate_in_source`].
+    fn triangles(&mut self, mode: Mode, ix: &[u32], place: &Place) -> Result<Vec<[u32; 3]>> {
+        let n = ix.len();
+        let mut out = Vec::with_capacity(if mode == Mode::Triangles {
+            n / 3
+        } else {
+            n.saturating_sub(2)
+        });
+        match mode {
+            Mode::Triangles => {
+                if n % 3 != 0 {
+                    return Err(self.fail(
+                        place.clone(),
+                        format!("{n} indices for a triangle list, not a multiple of 3"),
+                    ));
+                }
+                out.extend(ix.chunks_exact(3).map(|t| [t[0], t[1], t[2]]));
+            }
+            Mode::TriangleStrip | Mode::TriangleFan => {
+                for i in 0..n.saturating_sub(2) {
+                    let t = if mode == Mode::TriangleFan {
+                        [ix[i + 1], ix[i + 2], ix[0]]
+                    } else {
+                        [ix[i], ix[i + 1 + i % 2], ix[i + 2 - i % 2]]
+                    };
+                    if crate::mesh::is_degenerate(t) {
+                        self.raw.degenerate_in_source += 1;
+                    } else {
+                        out.push(t);
+                    }
+                }
+            }
+            _ => unreachable!("only triangle modes reach here"),
+        }
+        Ok(out)
+    }
+
+    /// The primitive material's base-colour factor; chooses the texture
+    /// when none is chosen yet, notes one that differs.
+    fn read_material(
+        &mut self,
+        primitive: &json::mesh::Primitive,
+        place: &Place,
+        has_uvs: bool,
+    ) -> Result<Vec4> {
+        let root = self.root;
+        let Some(mi) = primitive.material.map(|m| m.value()) else {
+            return Ok(Vec4::ONE);
+        };
+        let Some(material) = root.materials.get(mi) else {
+            return Err(self.fail(
+                place.clone(),
+                format!(
+                    "material {mi} does not exist ({} materials)",
+                    root.materials.len()
+                ),
+            ));
+        };
+        let pbr = &material.pbr_metallic_roughness;
+        let factor = Vec4::from_array(pbr.base_color_factor.0);
+        if !factor.is_finite() {
+            return Err(self.fail(
+                Place::element("material", mi as u64),
+                "the base-colour factor is not finite".into(),
+            ));
+        }
+        let factor = factor.clamp(Vec4::ZERO, Vec4::ONE);
+        if factor != Vec4::ONE && !self.factors_used {
+            // Colours so far were white.
+            self.factors_used = true;
+            let n = self.raw.positions.len();
+            self.raw
+                .properties
+                .colors
+                .get_or_insert_with(|| vec![Vec4::ONE; n]);
+        }
+        let Some(info) = &pbr.base_color_texture else {
+            return Ok(factor);
+        };
+        let ti = info.index.value();
+        let Some(texture) = root.textures.get(ti) else {
+            return Err(self.fail(
+                Place::element("material", mi as u64),
+                format!(
+                    "texture {ti} does not exist ({} textures)",
+                    root.textures.len()
+                ),
+            ));
+        };
+        let image = texture.source.value();
+        if info.tex_coord != 0 {
+            self.note(format!(
+                "material {mi}'s base-colour texture uses TEXCOORD_{}; only TEXCOORD_0 is read",
+                info.tex_coord
+            ));
+        }
+        if !has_uvs {
+            self.note(format!(
+                "{place} has a base-colour texture but no TEXCOORD_0: its texture coordinates \
+                 are (0, 0)"
+            ));
+        }
+        match &self.base_color {
+            None => {
+                let texture = self.image(image, Place::element("texture", ti as u64))?;
+                self.base_color = Some(BaseColor { image, texture });
+            }
+            Some(chosen) if chosen.image != image => {
+                let first = chosen.image;
+                self.note(format!(
+                    "material {mi} samples image {image}, another primitive image {first}: \
+                     the mesh keeps image {first} only"
+                ));
+            }
+            Some(_) => {}
+        }
+        Ok(factor)
+    }
+
+    /// Image `i` as a texture: a file beside the asset, or embedded bytes.
+    fn image(&mut self, i: usize, place: Place) -> Result<Texture> {
+        let root = self.root;
+        let Some(image) = root.images.get(i) else {
+            return Err(self.fail(
+                place,
+                format!("image {i} does not exist ({} images)", root.images.len()),
+            ));
+        };
+        let place = Place::element("image", i as u64);
+        let mime = image.mime_type.as_ref().map(|m| m.0.clone());
+        if let Some(view) = image.buffer_view {
+            let (buffer, range) = self.view_range(view.value(), &place)?;
+            let bytes = self.buffers[buffer]
+                .as_ref()
+                .map(|b| b.bytes[range].to_vec())
+                .unwrap_or_default();
+            return Ok(Texture::Embedded {
+                mime: mime.unwrap_or_default(),
+                bytes,
+            });
+        }
+        let Some(uri) = &image.uri else {
+            return Err(self.fail(place, "neither a uri nor a bufferView".into()));
+        };
+        match data_uri(uri).map_err(|m| self.fail(place.clone(), m))? {
+            Some((data_mime, bytes)) => Ok(Texture::Embedded {
+                mime: mime.unwrap_or(data_mime),
+                bytes,
+            }),
+            None => {
+                let relative = decode_uri(uri).map_err(|m| self.fail(place, m))?;
+                Ok(Texture::File(self.folder.join(relative)))
+            }
+        }
+    }
+
+    /// Reads buffer `b` if not read yet.
+    fn load_buffer(&mut self, b: usize, place: &Place) -> Result<()> {
+        let root = self.root;
+        let Some(buffer) = root.buffers.get(b) else {
+            return Err(self.fail(
+                place.clone(),
+                format!("buffer {b} does not exist ({} buffers)", root.buffers.len()),
+            ));
+        };
+        if self.buffers[b].is_some() {
+            return Ok(());
+        }
+        let bplace = Place::element("buffer", b as u64);
+        let loaded = match &buffer.uri {
+            None => match self.bin {
+                Some((bytes, base)) if b == 0 => Buffer {
+                    bytes: Cow::Borrowed(bytes),
+                    base: Some(base),
+                    origin: "the BIN chunk".into(),
+                },
+                _ => {
+                    return Err(self.fail(
+                        bplace,
+                        "no uri, and it is not buffer 0 of a .glb with a BIN chunk".into(),
+                    ))
+                }
+            },
+            Some(uri) => match data_uri(uri).map_err(|m| self.fail(bplace.clone(), m))? {
+                Some((_, bytes)) => Buffer {
+                    bytes: Cow::Owned(bytes),
+                    base: None,
+                    origin: "its data URI".into(),
+                },
+                None => {
+                    let relative = decode_uri(uri).map_err(|m| self.fail(bplace.clone(), m))?;
+                    let file = self.folder.join(relative);
+                    Buffer {
+                        bytes: Cow::Owned(read_file(&file)?),
+                        base: None,
+                        origin: file.display().to_string(),
+                    }
+                }
+            },
+        };
+        let declared = buffer.byte_length.0;
+        if (loaded.bytes.len() as u64) < declared {
+            return Err(self.fail(
+                bplace,
+                format!(
+                    "byteLength is {declared}, {} holds {} bytes",
+                    loaded.origin,
+                    loaded.bytes.len()
+                ),
+            ));
+        }
+        self.buffers[b] = Some(loaded);
+        Ok(())
+    }
+
+    /// Buffer view `v`'s buffer (read) and byte range in it, checked
+    /// against the buffer's declared length.
+    fn view_range(&mut self, v: usize, place: &Place) -> Result<(usize, std::ops::Range<usize>)> {
+        let root = self.root;
+        let Some(view) = root.buffer_views.get(v) else {
+            return Err(self.fail(
+                place.clone(),
+                format!(
+                    "buffer view {v} does not exist ({} buffer views)",
+                    root.buffer_views.len()
+                ),
+            ));
+        };
+        let vplace = Place::element("bufferView", v as u64);
+        let b = view.buffer.value();
+        self.load_buffer(b, &vplace)?;
+        let declared = root.buffers[b].byte_length.0;
+        let offset = view.byte_offset.map_or(0, |o| o.0);
+        let length = view.byte_length.0;
+        match offset.checked_add(length) {
+            Some(end) if end <= declared => Ok((b, offset as usize..end as usize)),
+            _ => Err(self.fail(
+                vplace,
+                format!(
+                    "bytes {offset}..{offset}+{length} lie beyond buffer {b} \
+                     ({declared} bytes)"
+                ),
+            )),
+        }
+    }
+
+    /// Accessor `a`'s layout, checked: a type of `dims` components, a
+    /// buffer view, and every element inside the view.
+    fn elements(
+        &mut self,
+        a: usize,
+        dims: &[usize],
+        what: &str,
+        place: &Place,
+    ) -> Result<Elements> {
+        let root = self.root;
+        let Some(accessor) = root.accessors.get(a) else {
+            return Err(self.fail(
+                place.clone(),
+                format!(
+                    "{what} accessor {a} does not exist ({} accessors)",
+                    root.accessors.len()
+                ),
+            ));
+        };
+        let aplace = Place::element("accessor", a as u64);
+        let (Checked::Valid(ty), Checked::Valid(shape)) = (accessor.component_type, accessor.type_)
+        else {
+            return Err(self.fail(aplace, "unknown componentType or type".into()));
+        };
+        let ty = ty.0;
+        let n = match shape {
+            Type::Scalar => 1,
+            Type::Vec2 => 2,
+            Type::Vec3 => 3,
+            Type::Vec4 => 4,
+            _ => 0,
+        };
+        if !dims.contains(&n) {
+            let want: Vec<String> = dims
+                .iter()
+                .map(|d| {
+                    if *d == 1 {
+                        "SCALAR".into()
+                    } else {
+                        format!("VEC{d}")
+                    }
+                })
+                .collect();
+            return Err(self.fail(
+                aplace,
+                format!("type {shape:?} where {what} needs {}", want.join(" or ")),
+            ));
+        }
+        if accessor.sparse.is_some() {
+            return Err(self.fail(
+                aplace,
+                "sparse accessors are not supported (only dense attributes and indices are read)"
+                    .into(),
+            ));
+        }
+        let Some(view) = accessor.buffer_view else {
+            return Err(self.fail(
+                aplace,
+                "no bufferView: an all-zero accessor is not read".into(),
+            ));
+        };
+        let v = view.value();
+        let (buffer, range) = self.view_range(v, &aplace)?;
+        let size = ty.size() * n;
+        let stride = root.buffer_views[v].byte_stride.map_or(size, |s| s.0);
+        if stride < size {
+            return Err(self.fail(
+                aplace,
+                format!(
+                    "buffer view {v}'s byteStride {stride} is less than an element ({size} bytes)"
+                ),
+            ));
+        }
+        let offset = accessor.byte_offset.map_or(0, |o| o.0);
+        let count = accessor.count.0;
+        // The last element ends at offset + stride * (count - 1) + size.
+        let end = match count {
+            0 => Some(offset),
+            _ => (count - 1)
+                .checked_mul(stride as u64)
+                .and_then(|x| x.checked_add(offset))
+                .and_then(|x| x.checked_add(size as u64)),
+        };
+        let view_length = (range.end - range.start) as u64;
+        let start = range.start as u64 + offset;
+        match end {
+            Some(end) if end <= view_length => Ok(Elements {
+                ty,
+                normalized: accessor.normalized,
+                dims: n,
+                count: count as usize,
+                start: start as usize,
+                stride,
+                buffer,
+            }),
+            _ => {
+                let b = &self.buffers[buffer];
+                let base = b.as_ref().and_then(|b| b.base);
+                let origin = b.as_ref().map(|b| b.origin.clone()).unwrap_or_default();
+                Err(self.fail(
+                    Place {
+                        byte: base.map(|base| base + start),
+                        ..aplace
+                    },
+                    format!(
+                        "{count} elements of {size} bytes every {stride} from byte {start} of \
+                         buffer {buffer} ({origin}) run past the end of buffer view {v} \
+                         ({view_length} bytes from byte {})",
+                        range.start
+                    ),
+                ))
+            }
+        }
+    }
+
+    /// The place of byte `at` of accessor `a`'s buffer.
+    fn byte_place(&self, a: usize, e: &Elements, at: usize) -> Place {
+        let base = self.buffers[e.buffer].as_ref().and_then(|b| b.base);
+        Place {
+            byte: base.map(|base| base + at as u64),
+            ..Place::element("accessor", a as u64)
+        }
+    }
+
+    /// The elements' components as `f32` (integers normalised when the
+    /// accessor says so), `dims` per element; all finite.
+    fn floats(&self, a: usize, e: &Elements) -> Result<Vec<f32>> {
+        let Some(buffer) = self.buffers[e.buffer].as_ref() else {
+            unreachable!("elements() reads the buffer");
+        };
+        let bytes = &buffer.bytes[..];
+        let size = e.ty.size();
+        let mut out = Vec::with_capacity(e.count * e.dims);
+        for k in 0..e.count {
+            let at = e.start + k * e.stride;
+            for j in 0..e.dims {
+                let x = component(&bytes[at + j * size..], e.ty, e.normalized);
+                if !x.is_finite() {
+                    return Err(self.fail(
+                        self.byte_place(a, e, at + j * size),
+                        format!(
+                            "component {j} of element {k} is {x} (byte {} of buffer {}, {})",
+                            at + j * size,
+                            e.buffer,
+                            buffer.origin
+                        ),
+                    ));
+                }
+                out.push(x);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Index accessor `a`'s values, each below `vertex_count`.
+    fn indices(&mut self, a: usize, vertex_count: usize, place: &Place) -> Result<Vec<u32>> {
+        let e = self.elements(a, &[1], "indices", place)?;
+        if !matches!(
+            e.ty,
+            ComponentType::U8 | ComponentType::U16 | ComponentType::U32
+        ) {
+            return Err(self.fail(
+                Place::element("accessor", a as u64),
+                format!(
+                    "indices of component type {:?}; only unsigned bytes, shorts and ints are indices",
+                    e.ty
+                ),
+            ));
+        }
+        let Some(buffer) = self.buffers[e.buffer].as_ref() else {
+            unreachable!("elements() reads the buffer");
+        };
+        let bytes = &buffer.bytes[..];
+        let mut out = Vec::with_capacity(e.count);
+        for k in 0..e.count {
+            let at = e.start + k * e.stride;
+            let i = match e.ty {
+                ComponentType::U8 => u32::from(bytes[at]),
+                ComponentType::U16 => u32::from(u16::from_le_bytes([bytes[at], bytes[at + 1]])),
+                _ => u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]),
+            };
+            if i as usize >= vertex_count {
+                return Err(self.fail(
+                    self.byte_place(a, &e, at),
+                    format!(
+                        "index {k} is {i}, the primitive has {vertex_count} vertices (byte {at} \
+                         of buffer {}, {})",
+                        e.buffer, buffer.origin
+                    ),
+                ));
+            }
+            out.push(i);
+        }
+        Ok(out)
+    }
+
+    fn finish(mut self) -> Result<RawMesh> {
+        self.raw.properties.texture = self.base_color.map(|b| b.texture);
+        Ok(self.raw)
+    }
+}
+
+/// Appends `count` values of a stream for vertices `before..`: `values`
+/// when the primitive has them (the stream created with `neutral` for the
+/// earlier vertices if it did not exist), else `neutral` when the stream
+/// exists.
+fn extend<T: Copy>(
+    stream: &mut Option<Vec<T>>,
+    before: usize,
+    count: usize,
+    values: Option<Vec<T>>,
+    neutral: T,
+) {
+    match values {
+        Some(values) => stream
+            .get_or_insert_with(|| vec![neutral; before])
+            .extend(values),
+        None => {
+            if let Some(s) = stream {
+                s.resize(before + count, neutral);
+            }
+        }
+    }
+}
+
+/// One component at the start of `bytes` (which holds at least its size),
+/// as `f32`: normalised integers map to 0..=1 (unsigned) or -1..=1
+/// (signed) as the specification's table of normalised integers says;
+/// others convert.
+fn component(bytes: &[u8], ty: ComponentType, normalized: bool) -> f32 {
+    let b = |i: usize| bytes[i];
+    match ty {
+        ComponentType::F32 => f32::from_le_bytes([b(0), b(1), b(2), b(3)]),
+        ComponentType::U8 if normalized => f32::from(b(0)) / 255.0,
+        ComponentType::U8 => f32::from(b(0)),
+        ComponentType::I8 if normalized => (f32::from(b(0) as i8) / 127.0).max(-1.0),
+        ComponentType::I8 => f32::from(b(0) as i8),
+        ComponentType::U16 => {
+            let x = f32::from(u16::from_le_bytes([b(0), b(1)]));
+            if normalized {
+                x / 65535.0
+            } else {
+                x
+            }
+        }
+        ComponentType::I16 => {
+            let x = f32::from(i16::from_le_bytes([b(0), b(1)]));
+            if normalized {
+                (x / 32767.0).max(-1.0)
+            } else {
+                x
+            }
+        }
+        ComponentType::U32 => u32::from_le_bytes([b(0), b(1), b(2), b(3)]) as f32,
+    }
+}
+
+/// The MIME type and decoded bytes of a base64 `data:` URI; `None` when
+/// `uri` is not a data URI.
+///
+/// # Errors
+/// A message when it is a data URI but not base64, or not valid base64.
+fn data_uri(uri: &str) -> std::result::Result<Option<(String, Vec<u8>)>, String> {
+    let Some(rest) = uri.strip_prefix("data:") else {
+        return Ok(None);
+    };
+    let Some((header, data)) = rest.split_once(',') else {
+        return Err("data URI without a comma before its data".into());
+    };
+    let Some(mime) = header.strip_suffix(";base64") else {
+        return Err(format!(
+            "data URI \"data:{header},\" is not base64 (only base64 data URIs are read)"
+        ));
+    };
+    let bytes = decode_base64(data).map_err(|m| format!("data URI: {m}"))?;
+    Ok(Some((mime.to_owned(), bytes)))
+}
+
+/// Decodes standard base64 (padding optional).
+///
+/// # Errors
+/// A message naming the character at fault, or a length no bytes fit.
+fn decode_base64(text: &str) -> std::result::Result<Vec<u8>, String> {
+    let mut out = Vec::with_capacity(text.len() / 4 * 3 + 2);
+    let (mut acc, mut bits) = (0u32, 0u32);
+    let mut padding = 0;
+    for (i, c) in text.char_indices() {
+        let v = match c {
+            'A'..='Z' => c as u32 - 'A' as u32,
+            'a'..='z' => c as u32 - 'a' as u32 + 26,
+            '0'..='9' => c as u32 - '0' as u32 + 52,
+            '+' => 62,
+            '/' => 63,
+            '=' if padding < 2 && i > 0 => {
+                padding += 1;
+                continue;
+            }
+            _ => return Err(not_base64(i, c)),
+        };
+        if padding > 0 {
+            return Err(not_base64(i, c));
+        }
+        acc = (acc << 6 | v) & 0xff_ffff;
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+        }
+    }
+    if bits == 6 {
+        return Err(format!(
+            "{} characters of data: one is left over that encodes no whole byte",
+            text.len() - padding
+        ));
+    }
+    Ok(out)
+}
+
+fn not_base64(at: usize, c: char) -> String {
+    format!(
+        "character {at} of the data, {c:?}, is not base64 (A-Z a-z 0-9 + /, then at most two '=')"
+    )
+}
+
+/// A relative URI reference as a path: `%XX` escapes decoded. Refuses
+/// URIs with a scheme (`http:`, `file:`): only files beside the asset and
+/// data URIs are read.
+pub(super) fn decode_uri(uri: &str) -> std::result::Result<PathBuf, String> {
+    if let Some((scheme, _)) = uri.split_once(':') {
+        let is_scheme = scheme.len() > 1
+            && scheme.starts_with(|c: char| c.is_ascii_alphabetic())
+            && scheme
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c));
+        if is_scheme {
+            return Err(format!(
+                "URI {uri:?} has the scheme {scheme:?}; only relative paths and data URIs are read"
+            ));
+        }
+    }
+    let raw = uri.as_bytes();
+    let mut bytes = Vec::with_capacity(raw.len());
+    let mut i = 0;
+    while i < raw.len() {
+        if raw[i] == b'%' {
+            let hex = raw
+                .get(i + 1..i + 3)
+                .and_then(|h| std::str::from_utf8(h).ok())
+                .and_then(|h| u8::from_str_radix(h, 16).ok());
+            let Some(byte) = hex else {
+                return Err(format!(
+                    "URI {uri:?}: '%' at {i} is not followed by two hex digits"
+                ));
+            };
+            bytes.push(byte);
+            i += 3;
+        } else {
+            bytes.push(raw[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(bytes)
+        .map(PathBuf::from)
+        .map_err(|_| format!("URI {uri:?} decodes to bytes that are not UTF-8"))
+}

@@ -1,0 +1,376 @@
+//! glTF 2.0 writer (feature `gltf`): one mesh, one indexed triangle-list
+//! primitive, as a `.glb` or as a `.gltf` with its buffer in a sibling
+//! `.bin`. The reader is [`super::parse_gltf`].
+//!
+//! Layout (glTF 2.0, binary data storage and the GLB format): one buffer of tightly packed, 4-byte
+//! aligned views in the order indices, `POSITION` (with the `min`/`max` the
+//! specification requires), then `NORMAL`, `TEXCOORD_0` (`v` flipped back
+//! to glTF's downward axis), `COLOR_0` (float vec4) when present, then the
+//! base-colour image when it is embedded. Indices are u16 when every index
+//! fits below 65535 (the value glTF reserves), else u32. The JSON is built
+//! with `serde_json` rather than `gltf-json`'s structs: the document is
+//! fixed and small, and the reader's tests parse every written file back
+//! with the `gltf` crate's full validation.
+//!
+//! What is lost: position ids (glTF has no seams; weld on load merges
+//! bit-identical positions again); zero normals are written as they are,
+//! which glTF validators report (glTF normals are unit length).
+//!
+//! The `v` flip `1 - v` is exact for `v` in `[0.5, 1]` and for every `v`
+//! that is a multiple of 2^-24 in `[0, 1]` (any texel corner of an image
+//! up to 2^24 texels wide); elsewhere `1 - (1 - v)` may differ from `v` by
+//! up to 2^-25 (half an ulp of 1.0).
+
+use crate::error::{Error, Result};
+use crate::mesh::{Mesh, Texture};
+use serde_json::{json, Value};
+use std::path::{Component, Path};
+
+/// glTF's `ARRAY_BUFFER` and `ELEMENT_ARRAY_BUFFER` targets, `FLOAT`,
+/// `UNSIGNED_SHORT` and `UNSIGNED_INT` component types, `TRIANGLES` mode.
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+const FLOAT: u32 = 5126;
+const UNSIGNED_SHORT: u32 = 5123;
+const UNSIGNED_INT: u32 = 5125;
+const TRIANGLES: u32 = 4;
+
+/// Writes `mesh` as glTF 2.0 to `path`: a single binary `.glb`, or a
+/// `.gltf` JSON file with its buffer beside it as `<stem>.bin`, chosen by
+/// the extension (see the module docs for the layout). The base-colour
+/// texture goes into the `.glb` as a buffer view (a [`Texture::File`] is
+/// read for that); a `.gltf` refers to a file by a relative URI and holds
+/// embedded bytes in its buffer. The mesh is expected to satisfy
+/// [`Mesh::validate`].
+///
+/// # Errors
+/// [`Error::InvalidArgument`] for another extension, a mesh without
+/// triangles, a `.glb` over 4 GiB, an embedded image that is neither PNG
+/// nor JPEG and names no MIME type, or a texture file with no relative path
+/// from the `.gltf`'s folder; [`Error::Io`] naming the file that cannot be
+/// written (or the texture file that cannot be read).
+///
+/// Cost: O(V + T); the buffer is built in memory (about 52 bytes per vertex
+/// with every property, 12 per triangle) before it is written.
+pub fn save_gltf(mesh: &Mesh, path: &Path) -> Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let binary = match ext.as_deref() {
+        Some("glb") => true,
+        Some("gltf") => false,
+        _ => {
+            return Err(Error::InvalidArgument(format!(
+                "{}: a glTF file is named .glb or .gltf",
+                path.display()
+            )))
+        }
+    };
+    if mesh.triangles.is_empty() {
+        return Err(Error::InvalidArgument(format!(
+            "{}: a mesh without triangles cannot be written as glTF (accessors hold at least one element)",
+            path.display()
+        )));
+    }
+    debug_assert!(mesh.validate().is_ok(), "save_gltf: {:?}", mesh.validate());
+    let mut out = Document::default();
+    let properties = &mesh.properties;
+
+    let corners = mesh.triangles.iter().flatten();
+    let (bytes, component) = if mesh.positions.len() > 65535 {
+        let bytes = corners.flat_map(|i| i.to_le_bytes()).collect();
+        (bytes, UNSIGNED_INT)
+    } else {
+        let bytes = corners.flat_map(|&i| (i as u16).to_le_bytes()).collect();
+        (bytes, UNSIGNED_SHORT)
+    };
+    let count = mesh.triangles.len() * 3;
+    let indices = out.accessor(bytes, ELEMENT_ARRAY_BUFFER, component, "SCALAR", count);
+    let floats = |values: &mut dyn Iterator<Item = f32>| -> Vec<u8> {
+        values.flat_map(f32::to_le_bytes).collect()
+    };
+    let mut attributes = serde_json::Map::new();
+    let n = mesh.positions.len();
+    let position = out.accessor(
+        floats(&mut mesh.positions.iter().flat_map(|p| p.to_array())),
+        ARRAY_BUFFER,
+        FLOAT,
+        "VEC3",
+        n,
+    );
+    let (lo, hi) = crate::mesh::bounds_of(&mesh.positions).unwrap_or_default();
+    out.accessors[position]["min"] = json!(lo.to_array());
+    out.accessors[position]["max"] = json!(hi.to_array());
+    attributes.insert("POSITION".into(), json!(position));
+    if let Some(normals) = &properties.normals {
+        let a = out.accessor(
+            floats(&mut normals.iter().flat_map(|v| v.to_array())),
+            ARRAY_BUFFER,
+            FLOAT,
+            "VEC3",
+            n,
+        );
+        attributes.insert("NORMAL".into(), json!(a));
+    }
+    if let Some(uvs) = &properties.uvs {
+        let a = out.accessor(
+            floats(&mut uvs.iter().flat_map(|t| [t.x, 1.0 - t.y])),
+            ARRAY_BUFFER,
+            FLOAT,
+            "VEC2",
+            n,
+        );
+        attributes.insert("TEXCOORD_0".into(), json!(a));
+    }
+    if let Some(colors) = &properties.colors {
+        let a = out.accessor(
+            floats(&mut colors.iter().flat_map(|c| c.to_array())),
+            ARRAY_BUFFER,
+            FLOAT,
+            "VEC4",
+            n,
+        );
+        attributes.insert("COLOR_0".into(), json!(a));
+    }
+    let mut primitive = json!({ "attributes": attributes, "indices": indices, "mode": TRIANGLES });
+    let mut root = json!({
+        "asset": { "version": "2.0", "generator": "mts" },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "mesh": 0 }],
+    });
+    if let Some(texture) = &properties.texture {
+        let image = out.image(texture, binary, path)?;
+        root["images"] = json!([image]);
+        root["textures"] = json!([{ "source": 0 }]);
+        root["materials"] = json!([{
+            "pbrMetallicRoughness": {
+                "baseColorTexture": { "index": 0 },
+                "metallicFactor": 0.0,
+                "roughnessFactor": 1.0,
+            }
+        }]);
+        primitive["material"] = json!(0);
+    }
+    root["meshes"] = json!([{ "primitives": [primitive] }]);
+    let mut buffer = json!({ "byteLength": out.bin.len() });
+    let bin_path = path.with_extension("bin");
+    if !binary {
+        let name = bin_path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .ok_or_else(|| {
+                Error::InvalidArgument(format!("{}: not a UTF-8 file name", path.display()))
+            })?;
+        buffer["uri"] = json!(encode_uri_segment(name));
+    }
+    root["buffers"] = json!([buffer]);
+    root["bufferViews"] = Value::Array(std::mem::take(&mut out.views));
+    root["accessors"] = Value::Array(std::mem::take(&mut out.accessors));
+
+    let io = |file: &Path| {
+        let file = file.to_owned();
+        move |source| Error::Io { file, source }
+    };
+    if binary {
+        let mut text = serde_json::to_vec(&root).expect("a JSON value serialises");
+        text.resize(text.len().next_multiple_of(4), b' ');
+        let mut bin = out.bin;
+        bin.resize(bin.len().next_multiple_of(4), 0);
+        let total = 12 + 8 + text.len() + 8 + bin.len();
+        let total = u32::try_from(total).map_err(|_| {
+            Error::InvalidArgument(format!(
+                "{}: {total} bytes, more than a .glb holds (4 GiB)",
+                path.display()
+            ))
+        })?;
+        let mut file = Vec::with_capacity(total as usize);
+        file.extend_from_slice(b"glTF");
+        file.extend_from_slice(&2u32.to_le_bytes());
+        file.extend_from_slice(&total.to_le_bytes());
+        for (kind, data) in [(b"JSON", &text), (b"BIN\0", &bin)] {
+            file.extend_from_slice(&(data.len() as u32).to_le_bytes());
+            file.extend_from_slice(kind);
+            file.extend_from_slice(data);
+        }
+        std::fs::write(path, file).map_err(io(path))
+    } else {
+        let text = serde_json::to_vec_pretty(&root).expect("a JSON value serialises");
+        std::fs::write(&bin_path, &out.bin).map_err(io(&bin_path))?;
+        std::fs::write(path, text).map_err(io(path))
+    }
+}
+
+/// The buffer and the views and accessors into it, as they are built.
+#[derive(Default)]
+struct Document {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Document {
+    /// Appends `data` as a 4-byte aligned buffer view; returns its index.
+    fn view(&mut self, data: &[u8], target: Option<u32>) -> usize {
+        self.bin.resize(self.bin.len().next_multiple_of(4), 0);
+        let mut view =
+            json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": data.len() });
+        if let Some(target) = target {
+            view["target"] = json!(target);
+        }
+        self.bin.extend_from_slice(data);
+        self.views.push(view);
+        self.views.len() - 1
+    }
+
+    /// Appends `data` as a view with one accessor over it; returns the
+    /// accessor's index.
+    fn accessor(
+        &mut self,
+        data: Vec<u8>,
+        target: u32,
+        component: u32,
+        ty: &str,
+        count: usize,
+    ) -> usize {
+        let view = self.view(&data, Some(target));
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": component,
+            "type": ty,
+            "count": count,
+        }));
+        self.accessors.len() - 1
+    }
+
+    /// The image object for `texture`: a buffer view of its bytes, or (for
+    /// a file written beside a `.gltf`) a relative URI.
+    fn image(&mut self, texture: &Texture, binary: bool, path: &Path) -> Result<Value> {
+        let (mime, bytes) = match texture {
+            Texture::File(file) if !binary => {
+                let folder = path.parent().unwrap_or(Path::new(""));
+                return Ok(json!({ "uri": relative_uri(file, folder)? }));
+            }
+            Texture::File(file) => {
+                let bytes = super::read_file(file)?;
+                let ext = file
+                    .extension()
+                    .and_then(|e| e.to_str())
+                    .map(str::to_ascii_lowercase);
+                let mime = match ext.as_deref() {
+                    Some("png") => "image/png",
+                    Some("jpg" | "jpeg") => "image/jpeg",
+                    _ => "",
+                };
+                (mime.to_owned(), bytes)
+            }
+            Texture::Embedded { mime, bytes } => (mime.clone(), bytes.clone()),
+        };
+        let mime = if mime.is_empty() {
+            sniff_mime(&bytes)
+                .ok_or_else(|| {
+                    Error::InvalidArgument(format!(
+                        "{}: the base-colour image is neither PNG nor JPEG and names no MIME type",
+                        path.display()
+                    ))
+                })?
+                .to_owned()
+        } else {
+            mime
+        };
+        let view = self.view(&bytes, None);
+        Ok(json!({ "bufferView": view, "mimeType": mime }))
+    }
+}
+
+/// `image/png` or `image/jpeg` from the image's signature.
+fn sniff_mime(bytes: &[u8]) -> Option<&'static str> {
+    if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        Some("image/png")
+    } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
+        Some("image/jpeg")
+    } else {
+        None
+    }
+}
+
+/// The URI of `file` relative to `folder`, both made absolute against the
+/// working directory (no symbolic link is resolved), each segment
+/// percent-encoded.
+fn relative_uri(file: &Path, folder: &Path) -> Result<String> {
+    let absolute = |p: &Path| {
+        std::path::absolute(if p.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            p
+        })
+        .map_err(|source| Error::Io {
+            file: p.to_owned(),
+            source,
+        })
+    };
+    fn normal(p: &Path) -> Vec<Component<'_>> {
+        p.components()
+            .filter(|c| !matches!(c, Component::CurDir))
+            .collect()
+    }
+    let (file_abs, folder_abs) = (absolute(file)?, absolute(folder)?);
+    let (f, d) = (normal(&file_abs), normal(&folder_abs));
+    let common = f.iter().zip(&d).take_while(|(a, b)| a == b).count();
+    if common == 0 {
+        return Err(Error::InvalidArgument(format!(
+            "texture {} has no relative path from {}",
+            file.display(),
+            folder.display()
+        )));
+    }
+    let mut segments: Vec<String> = vec!["..".into(); d.len() - common];
+    for c in &f[common..] {
+        let Some(s) = c.as_os_str().to_str() else {
+            return Err(Error::InvalidArgument(format!(
+                "texture {}: not a UTF-8 path",
+                file.display()
+            )));
+        };
+        segments.push(encode_uri_segment(s));
+    }
+    Ok(segments.join("/"))
+}
+
+/// Percent-encodes everything but RFC 3986's unreserved characters.
+fn encode_uri_segment(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for b in s.bytes() {
+        if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
+            out.push(b as char);
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uri_segments_round_trip_through_the_reader() {
+        let name = "a b%c+ü.png";
+        let uri = encode_uri_segment(name);
+        assert_eq!(uri, "a%20b%25c%2B%C3%BC.png");
+        assert_eq!(
+            super::super::gltf::decode_uri(&uri).unwrap(),
+            Path::new(name)
+        );
+    }
+
+    #[test]
+    fn relative_uris_climb_out_of_the_folder() {
+        let uri = relative_uri(Path::new("/a/b/tex/t.png"), Path::new("/a/b/out")).unwrap();
+        assert_eq!(uri, "../tex/t.png");
+        let uri = relative_uri(Path::new("/a/b/t.png"), Path::new("/a/b")).unwrap();
+        assert_eq!(uri, "t.png");
+    }
+}

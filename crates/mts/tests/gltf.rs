@@ -1,0 +1,744 @@
+//! glTF 2.0 in and out: round trips of a mesh with every property through
+//! `.glb` and `.gltf`, hand-made assets (node transforms, a mirror, strips
+//! and fans, skipped points, neutral fills, material factors), and every
+//! error the reader promises a place for, matched by variant and place.
+//! The shared models hold no glTF, so every asset is made here.
+
+use glam::{Vec2, Vec3, Vec4};
+use mts::mesh::generate::torus;
+use mts::mesh::io::{load, parse_gltf, save_gltf, Format, LoadOptions};
+use mts::mesh::{Mesh, RawMesh, Texture};
+use mts::{Error, Place};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+
+/// A 2 × 2 RGB PNG (red, green / blue, white).
+const PNG: &[u8] = &[
+    137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 2, 0, 0, 0, 2, 8, 2, 0,
+    0, 0, 253, 212, 154, 115, 0, 0, 0, 17, 73, 68, 65, 84, 120, 156, 99, 248, 207, 192, 192, 0,
+    194, 64, 18, 8, 0, 33, 237, 5, 251, 97, 102, 21, 174, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96,
+    130,
+];
+
+/// A fresh folder under Cargo's scratch space for integration tests.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("gltf")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A torus with unit normals, texture coordinates on a 1/4096 grid (the
+/// `v` flip is exact there), colours in 0..=1 and `texture`.
+fn textured_torus(major: u32, minor: u32, texture: Option<Texture>) -> Mesh {
+    let mut mesh = torus(major, minor);
+    let n = mesh.positions.len();
+    mesh.properties.normals = Some(mesh.positions.iter().map(|p| p.normalize()).collect());
+    mesh.properties.uvs = Some(
+        (0..n)
+            .map(|i| Vec2::new((i % 4096) as f32, (i * 7 % 4097) as f32) / 4096.0)
+            .collect(),
+    );
+    mesh.properties.colors = Some(
+        mesh.positions
+            .iter()
+            .map(|p| Vec4::new(p.x * 0.3 + 0.5, p.y * 0.3 + 0.5, 0.25, 1.0 - p.z.abs()))
+            .collect(),
+    );
+    mesh.properties.texture = texture;
+    mesh.validate().unwrap();
+    mesh
+}
+
+fn bits3(v: &[Vec3]) -> Vec<[u32; 3]> {
+    v.iter().map(|p| p.to_array().map(f32::to_bits)).collect()
+}
+
+/// `raw` holds exactly `mesh`'s vertices, triangles and properties, bit
+/// for bit.
+fn assert_same(raw: &RawMesh, mesh: &Mesh) {
+    assert_eq!(bits3(&raw.positions), bits3(&mesh.positions));
+    assert_eq!(raw.triangles, mesh.triangles);
+    let (a, b) = (&raw.properties, &mesh.properties);
+    assert_eq!(
+        a.normals.as_deref().map(bits3),
+        b.normals.as_deref().map(bits3)
+    );
+    let uv_bits = |u: &[Vec2]| -> Vec<[u32; 2]> {
+        u.iter().map(|t| t.to_array().map(f32::to_bits)).collect()
+    };
+    assert_eq!(a.uvs.as_deref().map(uv_bits), b.uvs.as_deref().map(uv_bits));
+    let colour_bits = |c: &[Vec4]| -> Vec<[u32; 4]> {
+        c.iter().map(|t| t.to_array().map(f32::to_bits)).collect()
+    };
+    assert_eq!(
+        a.colors.as_deref().map(colour_bits),
+        b.colors.as_deref().map(colour_bits)
+    );
+    assert!(a.position_ids.is_empty());
+}
+
+/// Reads `path` back: the raw mesh, after the `gltf` crate's full
+/// validation accepted the file as glTF 2.0.
+fn read_back(path: &Path) -> RawMesh {
+    let bytes = std::fs::read(path).unwrap();
+    if path.extension().unwrap() == "glb" {
+        gltf::Gltf::from_slice(&bytes).expect("the gltf crate accepts the file");
+    }
+    parse_gltf(&bytes, path).unwrap()
+}
+
+#[test]
+fn glb_round_trip_keeps_every_property_to_the_bit() {
+    let dir = scratch("glb_round_trip");
+    let texture = Texture::Embedded {
+        mime: "image/png".into(),
+        bytes: PNG.to_vec(),
+    };
+    let mesh = textured_torus(24, 12, Some(texture.clone()));
+    let path = dir.join("torus.glb");
+    save_gltf(&mesh, &path).unwrap();
+    let raw = read_back(&path);
+    assert_same(&raw, &mesh);
+    assert_eq!(raw.properties.texture, Some(texture));
+    let (loaded, report) = load(&path, LoadOptions::default()).unwrap();
+    assert_eq!(loaded.vertex_count(), 24 * 12);
+    assert_eq!(loaded.triangle_count(), 2 * 24 * 12);
+    assert_eq!(report.degenerate_dropped, 0);
+}
+
+#[test]
+fn gltf_round_trip_keeps_every_property_and_the_texture_file() {
+    let dir = scratch("gltf_round_trip");
+    std::fs::write(dir.join("skin.png"), PNG).unwrap();
+    let texture = Texture::File(dir.join("skin.png"));
+    let mesh = textured_torus(24, 12, Some(texture.clone()));
+    let path = dir.join("torus.gltf");
+    save_gltf(&mesh, &path).unwrap();
+    assert!(dir.join("torus.bin").is_file());
+    let document: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    assert_eq!(document["images"][0]["uri"], "skin.png");
+    assert_eq!(document["buffers"][0]["uri"], "torus.bin");
+    gltf::Gltf::from_slice(&std::fs::read(&path).unwrap()).expect("valid glTF");
+    let raw = read_back(&path);
+    assert_same(&raw, &mesh);
+    assert_eq!(raw.properties.texture, Some(texture));
+
+    // An embedded image stays embedded in the .gltf's buffer.
+    let embedded = Texture::Embedded {
+        mime: String::new(),
+        bytes: PNG.to_vec(),
+    };
+    let mesh = textured_torus(5, 4, Some(embedded));
+    save_gltf(&mesh, &path).unwrap();
+    assert_eq!(
+        read_back(&path).properties.texture,
+        Some(Texture::Embedded {
+            mime: "image/png".into(),
+            bytes: PNG.to_vec()
+        })
+    );
+}
+
+/// A texture file goes into a `.glb` as bytes; a `.gltf` in another folder
+/// refers to it by a relative path.
+#[test]
+fn texture_files_are_embedded_in_glb_and_referred_to_from_gltf() {
+    let dir = scratch("texture_files");
+    std::fs::create_dir_all(dir.join("images")).unwrap();
+    std::fs::create_dir_all(dir.join("out")).unwrap();
+    let png = dir.join("images/a b.png");
+    std::fs::write(&png, PNG).unwrap();
+    let mesh = textured_torus(6, 5, Some(Texture::File(png.clone())));
+    save_gltf(&mesh, &dir.join("out/t.glb")).unwrap();
+    assert_eq!(
+        read_back(&dir.join("out/t.glb")).properties.texture,
+        Some(Texture::Embedded {
+            mime: "image/png".into(),
+            bytes: PNG.to_vec()
+        })
+    );
+    save_gltf(&mesh, &dir.join("out/t.gltf")).unwrap();
+    let document: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("out/t.gltf")).unwrap()).unwrap();
+    assert_eq!(document["images"][0]["uri"], "../images/a%20b.png");
+    assert_eq!(
+        read_back(&dir.join("out/t.gltf")).properties.texture,
+        Some(Texture::File(dir.join("out/../images/a b.png")))
+    );
+}
+
+/// More than 65535 vertices: u32 indices; a mesh of positions only has no
+/// other attribute and no material.
+#[test]
+fn large_mesh_round_trips_with_u32_indices() {
+    let dir = scratch("large");
+    let mesh = torus(300, 250);
+    let path = dir.join("big.glb");
+    save_gltf(&mesh, &path).unwrap();
+    let raw = read_back(&path);
+    assert_same(&raw, &mesh);
+    assert!(raw.properties.is_empty() && raw.properties.texture.is_none());
+    let document = gltf::Gltf::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let indices = document.accessors().next().unwrap();
+    assert_eq!(indices.data_type(), gltf::accessor::DataType::U32);
+    assert_eq!(document.materials().count(), 0);
+}
+
+/// The `v` flip `1 - v` rounds where `v` has bits below 2^-24: within half
+/// an ulp of 1.0.
+#[test]
+fn arbitrary_texture_coordinates_come_back_within_half_an_ulp_of_one() {
+    let dir = scratch("uv_rounding");
+    let mut mesh = torus(7, 5);
+    let uvs: Vec<Vec2> = (0..mesh.positions.len())
+        .map(|i| Vec2::splat(0.1 + i as f32 * 1e-3))
+        .collect();
+    mesh.properties.uvs = Some(uvs.clone());
+    let path = dir.join("uv.glb");
+    save_gltf(&mesh, &path).unwrap();
+    let back = read_back(&path).properties.uvs.unwrap();
+    for (a, b) in back.iter().zip(&uvs) {
+        assert_eq!(a.x.to_bits(), b.x.to_bits());
+        assert!((a.y - b.y).abs() <= 2f32.powi(-25), "{} vs {}", a.y, b.y);
+    }
+}
+
+#[test]
+fn format_detection_knows_gltf_by_extension_and_glb_by_magic() {
+    assert_eq!(
+        Format::detect(Path::new("a.GLTF"), b"{").unwrap(),
+        Format::Gltf
+    );
+    assert_eq!(
+        Format::detect(Path::new("a.glb"), b"").unwrap(),
+        Format::Gltf
+    );
+    assert_eq!(
+        Format::detect(Path::new("noext"), b"glTF\x02\0\0\0").unwrap(),
+        Format::Gltf
+    );
+}
+
+// ---------------------------------------------------------------------
+// Hand-made assets.
+
+/// A buffer being built; each `put` returns the (offset, length) of what it
+/// appended, 4-byte aligned.
+#[derive(Default)]
+struct Bin(Vec<u8>);
+
+impl Bin {
+    fn put(&mut self, bytes: &[u8]) -> (usize, usize) {
+        self.0.resize(self.0.len().next_multiple_of(4), 0);
+        let at = self.0.len();
+        self.0.extend_from_slice(bytes);
+        (at, bytes.len())
+    }
+    fn f32s(&mut self, values: &[f32]) -> (usize, usize) {
+        let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
+        self.put(&bytes)
+    }
+    fn u16s(&mut self, values: &[u16]) -> (usize, usize) {
+        let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
+        self.put(&bytes)
+    }
+}
+
+fn base64(bytes: &[u8]) -> String {
+    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for group in bytes.chunks(3) {
+        let b = [
+            group[0],
+            *group.get(1).unwrap_or(&0),
+            *group.get(2).unwrap_or(&0),
+        ];
+        let n = u32::from(b[0]) << 16 | u32::from(b[1]) << 8 | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= group.len() {
+                out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// A buffer view over `(offset, length)` of buffer 0.
+fn view((offset, length): (usize, usize)) -> Value {
+    json!({ "buffer": 0, "byteOffset": offset, "byteLength": length })
+}
+
+/// An accessor over view `view` of `count` elements.
+fn accessor(view: usize, component: u32, ty: &str, count: usize) -> Value {
+    json!({ "bufferView": view, "componentType": component, "type": ty, "count": count })
+}
+
+const FLOAT: u32 = 5126;
+const UBYTE: u32 = 5121;
+const USHORT: u32 = 5123;
+
+/// `body` as a `.gltf` whose buffer 0 is `bin` as a data URI.
+fn gltf_text(bin: &Bin, mut body: Value) -> Vec<u8> {
+    body["asset"] = json!({ "version": "2.0" });
+    body["buffers"] = json!([{
+        "byteLength": bin.0.len(),
+        "uri": format!("data:application/octet-stream;base64,{}", base64(&bin.0)),
+    }]);
+    serde_json::to_vec(&body).unwrap()
+}
+
+/// `body` as a `.glb` whose BIN chunk is `bin`, and the file offset of the
+/// BIN chunk's data.
+fn glb(bin: &Bin, mut body: Value) -> (Vec<u8>, u64) {
+    body["asset"] = json!({ "version": "2.0" });
+    body["buffers"] = json!([{ "byteLength": bin.0.len() }]);
+    let mut text = serde_json::to_vec(&body).unwrap();
+    text.resize(text.len().next_multiple_of(4), b' ');
+    let mut data = bin.0.clone();
+    data.resize(data.len().next_multiple_of(4), 0);
+    let total = 12 + 8 + text.len() + 8 + data.len();
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(&text);
+    out.extend((data.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    let bin_at = out.len() as u64;
+    out.extend(&data);
+    (out, bin_at)
+}
+
+//  2
+//  | \      one triangle, counter-clockwise seen from +z, normals
+//  0 - 1    (0.6, 0, 0.8), indices u16.
+fn triangle_asset(bin: &mut Bin) -> Value {
+    let p = bin.f32s(&[0., 0., 0., 1., 0., 0., 0., 1., 0.]);
+    let n = bin.f32s(&[0.6, 0., 0.8, 0.6, 0., 0.8, 0.6, 0., 0.8]);
+    let i = bin.u16s(&[0, 1, 2]);
+    json!({
+        "bufferViews": [view(p), view(n), view(i)],
+        "accessors": [
+            accessor(0, FLOAT, "VEC3", 3),
+            accessor(1, FLOAT, "VEC3", 3),
+            accessor(2, USHORT, "SCALAR", 3),
+        ],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0, "NORMAL": 1 }, "indices": 2 }] }],
+    })
+}
+
+/// The default scene (1, not 0) places the triangle under a matrix (scale
+/// 2, then x + 10) and under a mirror `x -> -x` above a translation
+/// `z + 5`: positions moved, the mirrored copy's winding flipped and its
+/// normals mirrored. Scene 0's node is not read.
+#[test]
+fn node_transforms_move_positions_and_mirrors_flip_winding() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["nodes"] = json!([
+        { "matrix": [2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 10, 0, 0, 1], "mesh": 0 },
+        { "scale": [-1, 1, 1], "children": [2] },
+        { "translation": [0, 0, 5], "mesh": 0 },
+        { "translation": [100, 0, 0], "mesh": 0 },
+    ]);
+    body["scenes"] = json!([{ "nodes": [3] }, { "nodes": [0, 1] }]);
+    body["scene"] = json!(1);
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    let v = Vec3::new;
+    assert_eq!(
+        raw.positions,
+        [
+            v(10., 0., 0.),
+            v(12., 0., 0.),
+            v(10., 2., 0.),
+            v(0., 0., 5.),
+            v(-1., 0., 5.),
+            v(0., 1., 5.)
+        ]
+    );
+    assert_eq!(raw.triangles, [[0, 1, 2], [3, 5, 4]]);
+    let normals = raw.properties.normals.unwrap();
+    let expected = [v(0.6, 0., 0.8); 3]
+        .into_iter()
+        .chain([v(-0.6, 0., 0.8); 3]);
+    for (n, e) in normals.iter().zip(expected) {
+        assert!((*n - e).length() < 1e-6, "{n} vs {e}");
+    }
+}
+
+/// Without scenes every root node is read; without nodes every mesh.
+#[test]
+fn without_a_scene_root_nodes_then_meshes_are_read() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    let raw = parse_gltf(&gltf_text(&bin, body.clone()), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    body["nodes"] = json!([
+        { "children": [1], "translation": [0, 0, 1] },
+        { "mesh": 0 },
+        { "mesh": 0 },
+    ]);
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2], [3, 4, 5]]);
+    assert_eq!(raw.positions[0], Vec3::new(0., 0., 1.));
+    assert_eq!(raw.positions[3], Vec3::ZERO);
+}
+
+//  1   3          a strip (u8 indices 0 1 2 3 3 4: two triangles, then two
+//  | \ | \        degenerate joins), a fan over five unindexed vertices, a
+//  0 - 2 - 4      points and a lines primitive (skipped).
+#[test]
+fn strips_and_fans_become_triangles_and_points_are_skipped() {
+    let mut bin = Bin::default();
+    let p = bin.f32s(&[0., 0., 0., 0., 1., 0., 1., 0., 0., 1., 1., 0., 2., 0., 0.]);
+    let i = bin.put(&[0, 1, 2, 3, 3, 4]);
+    let body = json!({
+        "bufferViews": [view(p), view(i)],
+        "accessors": [accessor(0, FLOAT, "VEC3", 5), accessor(1, UBYTE, "SCALAR", 6)],
+        "meshes": [{ "name": "parts", "primitives": [
+            { "attributes": { "POSITION": 0 }, "indices": 1, "mode": 5 },
+            { "attributes": { "POSITION": 0 }, "mode": 0 },
+            { "attributes": { "POSITION": 0 }, "mode": 6 },
+            { "attributes": { "POSITION": 0 }, "indices": 1, "mode": 1 },
+        ] }],
+    });
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.positions.len(), 10);
+    assert_eq!(
+        raw.triangles,
+        [[0, 1, 2], [1, 3, 2], [6, 7, 5], [7, 8, 5], [8, 9, 5]]
+    );
+    assert_eq!(raw.degenerate_in_source, 2);
+}
+
+/// A primitive without normals or colours gets zero normals and its
+/// material's base-colour factor as colour; one with `COLOR_0` as
+/// normalised u8 vec3 gets alpha 1; no primitive has texture coordinates,
+/// so there is no UV stream.
+#[test]
+fn missing_attributes_are_filled_with_neutral_values() {
+    let mut bin = Bin::default();
+    let p = bin.f32s(&[0., 0., 0., 1., 0., 0., 0., 1., 0.]);
+    let n = bin.f32s(&[0., 0., 1., 0., 0., 1., 0., 0., 1.]);
+    let c = bin.put(&[255, 0, 51, 0, 0, 255, 0, 0, 0, 0, 255]);
+    let mut colors = accessor(2, UBYTE, "VEC3", 3);
+    colors["normalized"] = json!(true);
+    let body = json!({
+        "bufferViews": [view(p), view(n), { "buffer": 0, "byteOffset": c.0, "byteLength": 11, "byteStride": 4 }],
+        "accessors": [accessor(0, FLOAT, "VEC3", 3), accessor(1, FLOAT, "VEC3", 3), colors],
+        "materials": [{ "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.25, 1, 1] } }],
+        "meshes": [{ "primitives": [
+            { "attributes": { "POSITION": 0 }, "material": 0 },
+            { "attributes": { "POSITION": 0, "NORMAL": 1, "COLOR_0": 2 } },
+        ] }],
+    });
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    let properties = raw.properties;
+    assert_eq!(
+        properties.normals.unwrap(),
+        [[Vec3::ZERO; 3], [Vec3::Z; 3]].concat()
+    );
+    assert!(properties.uvs.is_none());
+    let factor = Vec4::new(0.5, 0.25, 1.0, 1.0);
+    let byte = |x: u8| f32::from(x) / 255.0;
+    assert_eq!(
+        properties.colors.unwrap(),
+        [
+            factor,
+            factor,
+            factor,
+            Vec4::new(1.0, 0.0, byte(51), 1.0),
+            Vec4::new(0.0, 1.0, 0.0, 1.0),
+            Vec4::new(0.0, 0.0, 1.0, 1.0),
+        ]
+    );
+}
+
+/// An external buffer is read relative to the `.gltf`'s folder; a missing
+/// one is an I/O error naming that file.
+#[test]
+fn external_buffers_are_read_beside_the_file() {
+    let dir = scratch("external");
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["asset"] = json!({ "version": "2.0" });
+    body["buffers"] = json!([{ "byteLength": bin.0.len(), "uri": "data%20file.bin" }]);
+    let path = dir.join("t.gltf");
+    std::fs::write(&path, serde_json::to_vec(&body).unwrap()).unwrap();
+    match load(&path, LoadOptions::default()).unwrap_err() {
+        Error::Io { file, .. } => assert_eq!(file, dir.join("data file.bin")),
+        other => panic!("expected an I/O error, got {other:?}"),
+    }
+    std::fs::write(dir.join("data file.bin"), &bin.0).unwrap();
+    let (mesh, _) = load(&path, LoadOptions::default()).unwrap();
+    assert_eq!(mesh.triangles, [[0, 1, 2]]);
+}
+
+// ---------------------------------------------------------------------
+// Errors, matched by variant and place.
+
+fn parse_error(bytes: &[u8], name: &str) -> Place {
+    match parse_gltf(bytes, Path::new(name)) {
+        Err(Error::Parse { file, place, .. }) => {
+            assert_eq!(file, Path::new(name));
+            place
+        }
+        Err(e) => panic!("not a parse error: {e}"),
+        Ok(raw) => panic!("expected an error, got {} triangles", raw.triangles.len()),
+    }
+}
+
+fn at(element: &str, index: u64, byte: Option<u64>) -> Place {
+    Place {
+        byte,
+        ..Place::element(element, index)
+    }
+}
+
+#[test]
+fn accessor_beyond_its_buffer_view_is_refused_with_its_byte() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["accessors"][1]["count"] = json!(4);
+    body["accessors"][1]["byteOffset"] = json!(0);
+    // In a .gltf the data is in a data URI: no byte of the file.
+    assert_eq!(
+        parse_error(&gltf_text(&bin, body.clone()), "t.gltf"),
+        at("accessor", 1, None)
+    );
+    // In a .glb: the byte where the accessor starts (view 1 is at 36).
+    let (file, bin_at) = glb(&bin, body.clone());
+    assert_eq!(
+        parse_error(&file, "t.glb"),
+        at("accessor", 1, Some(bin_at + 36))
+    );
+    // A view past its buffer's byteLength.
+    body["accessors"][1]["count"] = json!(3);
+    body["bufferViews"][1]["byteLength"] = json!(1000);
+    assert_eq!(
+        parse_error(&gltf_text(&bin, body.clone()), "t.gltf"),
+        at("bufferView", 1, None)
+    );
+    // A count whose byte size overflows.
+    body["bufferViews"][1]["byteLength"] = json!(36);
+    body["accessors"][1]["count"] = json!(u64::MAX / 2);
+    let (file, bin_at) = glb(&bin, body);
+    assert_eq!(
+        parse_error(&file, "t.glb"),
+        at("accessor", 1, Some(bin_at + 36))
+    );
+}
+
+#[test]
+fn index_out_of_range_is_refused_with_its_byte() {
+    let mut bin = Bin::default();
+    let p = bin.f32s(&[0., 0., 0., 1., 0., 0., 0., 1., 0.]);
+    let i = bin.u16s(&[0, 1, 2, 2, 1, 3]);
+    let body = json!({
+        "bufferViews": [view(p), view(i)],
+        "accessors": [accessor(0, FLOAT, "VEC3", 3), accessor(1, USHORT, "SCALAR", 6)],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 }, "indices": 1 }] }],
+    });
+    let (file, bin_at) = glb(&bin, body);
+    assert_eq!(
+        parse_error(&file, "t.glb"),
+        at("accessor", 1, Some(bin_at + i.0 as u64 + 10))
+    );
+}
+
+#[test]
+fn nan_position_is_refused_with_its_byte() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    bin.0[12..16].copy_from_slice(&f32::NAN.to_le_bytes());
+    let (file, bin_at) = glb(&bin, body.clone());
+    assert_eq!(
+        parse_error(&file, "t.glb"),
+        at("accessor", 0, Some(bin_at + 12))
+    );
+    // So is a position a transform sends to infinity.
+    bin.0[12..16].copy_from_slice(&3e38f32.to_le_bytes());
+    body["nodes"] = json!([{ "scale": [10, 1, 1], "mesh": 0 }]);
+    assert_eq!(
+        parse_error(&glb(&bin, body).0, "t.glb"),
+        Place::element("mesh 0 primitive", 0)
+    );
+}
+
+#[test]
+fn truncated_glb_is_refused_at_the_chunk() {
+    let mut bin = Bin::default();
+    let body = triangle_asset(&mut bin);
+    let (file, bin_at) = glb(&bin, body);
+    let bin_header = bin_at - 8;
+    assert_eq!(
+        parse_error(&file[..file.len() - 4], "t.glb"),
+        at("GLB chunk", 1, Some(bin_header))
+    );
+    assert_eq!(
+        parse_error(&file[..bin_header as usize + 3], "t.glb"),
+        at("GLB chunk", 1, Some(bin_header))
+    );
+    // Cut exactly between chunks: the header's length tells.
+    assert_eq!(
+        parse_error(&file[..bin_header as usize], "t.glb"),
+        Place {
+            byte: Some(8),
+            element: Some("GLB header".into()),
+            ..Place::default()
+        }
+    );
+    assert_eq!(
+        parse_error(&file[..7], "t.glb"),
+        Place {
+            byte: Some(0),
+            element: Some("GLB header".into()),
+            ..Place::default()
+        }
+    );
+    // Every cut is an error, never a panic.
+    for len in 4..file.len() {
+        assert!(
+            parse_gltf(&file[..len], Path::new("t.glb")).is_err(),
+            "{len}"
+        );
+    }
+}
+
+#[test]
+fn bad_base64_is_refused_at_its_buffer() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["asset"] = json!({ "version": "2.0" });
+    for uri in [
+        "data:application/octet-stream;base64,AAA!",
+        "data:application/octet-stream;base64,AAAAA",
+        "data:application/octet-stream;base64,AA=A",
+        "data:application/octet-stream,AAAA",
+    ] {
+        body["buffers"] = json!([{ "byteLength": 3, "uri": uri }]);
+        let text = serde_json::to_vec(&body).unwrap();
+        assert_eq!(
+            parse_error(&text, "t.gltf"),
+            Place::element("buffer", 0),
+            "{uri}"
+        );
+    }
+}
+
+#[test]
+fn unsupported_and_malformed_structures_are_refused_at_their_object() {
+    let mut bin = Bin::default();
+    let base = triangle_asset(&mut bin);
+    let case = |edit: &dyn Fn(&mut Value)| {
+        let mut body = base.clone();
+        edit(&mut body);
+        parse_error(&gltf_text(&bin, body), "t.gltf")
+    };
+    // Sparse accessors.
+    let sparse = json!({ "count": 1, "indices": { "bufferView": 2, "componentType": USHORT },
+                         "values": { "bufferView": 0 } });
+    assert_eq!(
+        case(&|b| b["accessors"][0]["sparse"] = sparse.clone()),
+        Place::element("accessor", 0)
+    );
+    // A POSITION accessor that does not exist (the gltf crate's own
+    // validation would panic here).
+    assert_eq!(
+        case(&|b| b["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(9)),
+        Place::element("mesh 0 primitive", 0)
+    );
+    // Positions as VEC2.
+    assert_eq!(
+        case(&|b| b["accessors"][0]["type"] = json!("VEC2")),
+        Place::element("accessor", 0)
+    );
+    // A node cycle, and a node listed twice.
+    assert_eq!(
+        case(&|b| {
+            b["nodes"] = json!([{ "children": [1] }, { "children": [0], "mesh": 0 }]);
+            b["scenes"] = json!([{ "nodes": [0] }]);
+        }),
+        Place::element("node", 0)
+    );
+    assert_eq!(
+        case(&|b| {
+            b["nodes"] = json!([{ "mesh": 0 }]);
+            b["scenes"] = json!([{ "nodes": [0, 0] }]);
+        }),
+        Place::element("node", 0)
+    );
+    // A required extension this reader does not know.
+    assert_eq!(
+        case(&|b| b["extensionsRequired"] = json!(["KHR_draco_mesh_compression"])),
+        Place::element("extensionsRequired", 0)
+    );
+    // A triangle list whose index count is not a multiple of 3.
+    assert_eq!(
+        case(&|b| b["accessors"][2]["count"] = json!(2)),
+        Place::element("mesh 0 primitive", 0)
+    );
+    // A buffer whose data is shorter than its byteLength.
+    let mut body = base.clone();
+    body["asset"] = json!({ "version": "2.0" });
+    body["buffers"] = json!([{ "byteLength": 1000, "uri": "data:;base64,AAAA" }]);
+    assert_eq!(
+        parse_error(&serde_json::to_vec(&body).unwrap(), "t.gltf"),
+        Place::element("buffer", 0)
+    );
+    // Not JSON: the line.
+    assert_eq!(parse_error(b"{\n\"asset\": ", "t.gltf"), Place::line(2));
+}
+
+/// A chain of 100,000 nested nodes is walked without recursion.
+#[test]
+fn deep_node_chains_do_not_overflow_the_stack() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    let depth = 100_000;
+    let nodes: Vec<Value> = (0..depth)
+        .map(|i| {
+            if i + 1 < depth {
+                json!({ "children": [i + 1], "translation": [1, 0, 0] })
+            } else {
+                json!({ "mesh": 0 })
+            }
+        })
+        .collect();
+    body["nodes"] = Value::Array(nodes);
+    body["scenes"] = json!([{ "nodes": [0] }]);
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.positions[0], Vec3::new((depth - 1) as f32, 0.0, 0.0));
+}
+
+/// Every byte of a small `.glb` set to each of a few values (digits turn
+/// counts and offsets into other numbers): an error or a mesh, never a
+/// panic, and no mesh with an index out of range.
+#[test]
+fn corrupted_glb_bytes_never_panic() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["nodes"] = json!([{ "mesh": 0, "children": [1] }, { "mesh": 0, "scale": [1, -1, 1] }]);
+    body["scenes"] = json!([{ "nodes": [0] }]);
+    let (file, _) = glb(&bin, body);
+    let mut accepted = 0;
+    for at in 0..file.len() {
+        for value in [0u8, 0xff, b'9', b'0', b'-'] {
+            let mut bytes = file.clone();
+            bytes[at] = value;
+            if let Ok(raw) = parse_gltf(&bytes, Path::new("t.glb")) {
+                let n = raw.positions.len() as u32;
+                assert!(raw.triangles.iter().flatten().all(|&v| v < n), "byte {at}");
+                assert!(raw.positions.iter().all(|p| p.is_finite()), "byte {at}");
+                accepted += 1;
+            }
+        }
+    }
+    assert!(accepted > 0);
+}
