@@ -48,7 +48,7 @@ enum Command {
     Simplify(SimplifyArgs),
     /// Hausdorff and RMS distance of a mesh to a reference mesh.
     Distance(DistanceArgs),
-    /// Write a mesh (a file or a generated one) as OBJ.
+    /// Write a mesh (a file or a generated one) as OBJ, glTF (.glb/.gltf) by the extension of the output.
     Convert(ConvertArgs),
     /// Build the MTS model (strips, contraction sequence, per-strip graphs)
     /// and write it as an .mts file.
@@ -443,7 +443,7 @@ struct SimplifyArgs {
     /// Keep at most this many triangles.
     #[arg(allow_negative_numbers = true, long)]
     triangles: Option<usize>,
-    /// Write the simplified mesh as OBJ.
+    /// Write the simplified mesh (.obj, .glb or .gltf, by extension; with --properties, its properties).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Print JSON instead of a table.
@@ -719,6 +719,7 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
             .copied()
             .collect(),
         triangles: collapses.triangles_at(&mesh, lod),
+        properties: Default::default(),
     };
     // Compare at one triangle count: ours at the target, meshoptimizer
     // asked for the same; when it stops above it, ours at its count.
@@ -740,7 +741,7 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
         (lod, d, serde_json::Value::Null)
     };
     if let Some(path) = &args.output {
-        mts::mesh::io::save_obj(&collapses.mesh_at(&mesh, lod), path)?;
+        mts::mesh::io::save_mesh(&collapses.mesh_at(&mesh, lod), path)?;
     }
     let v = json!({
         "mesh": name,
@@ -824,7 +825,7 @@ fn distance(args: &DistanceArgs) -> Result<()> {
 
 fn convert(args: &ConvertArgs) -> Result<()> {
     let (_, mesh, _) = args.source.load()?;
-    mts::mesh::io::save_obj(&mesh, &args.output)?;
+    mts::mesh::io::save_mesh(&mesh, &args.output)?;
     Ok(())
 }
 
@@ -1017,7 +1018,7 @@ struct ExtractArgs {
     source: MeshSource,
     #[command(flatten)]
     level: LevelArgs,
-    /// Write the extracted triangles as OBJ.
+    /// Write the extracted triangles (.obj, .glb or .gltf, by extension).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Timed extractions from scratch (1 to 10,000); the median is reported.
@@ -1113,7 +1114,7 @@ fn extract(args: &ExtractArgs) -> Result<()> {
             triangles: ex.triangles(),
             properties: Default::default(),
         };
-        mts::mesh::io::save_obj(&mesh, out)?;
+        mts::mesh::io::save_mesh(&mesh, out)?;
     }
     if args.json {
         println!(
@@ -1334,7 +1335,7 @@ fn extract_baseline(args: &ExtractArgs) -> Result<()> {
             triangles: triangles.clone(),
             properties: Default::default(),
         };
-        mts::mesh::io::save_obj(&m, out)?;
+        mts::mesh::io::save_mesh(&m, out)?;
     }
     let method = source.name();
     if args.json {
@@ -1417,7 +1418,7 @@ struct DecodeArgs {
     /// Decode only the first N bytes (the packets they hold completely).
     #[arg(allow_negative_numbers = true, long)]
     bytes: Option<usize>,
-    /// Write the decoded mesh as OBJ.
+    /// Write the decoded mesh (.obj, .glb or .gltf, by extension).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Print JSON instead of a sentence.
@@ -1440,7 +1441,7 @@ fn decode(args: &DecodeArgs) -> Result<()> {
     let mesh = d.mesh();
     mesh.validate()?;
     if let Some(out) = &args.output {
-        mts::mesh::io::save_obj(&mesh, out)?;
+        mts::mesh::io::save_mesh(&mesh, out)?;
     }
     if args.json {
         println!(

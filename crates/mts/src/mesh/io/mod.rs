@@ -214,6 +214,29 @@ pub fn load(path: &Path, options: LoadOptions) -> Result<(Mesh, CleanReport)> {
     clean(raw, options.clean, &path.display().to_string())
 }
 
+/// Writes `mesh` in the format its extension names: `.obj`
+/// ([`save_obj`]), and with the `gltf` feature `.glb` and `.gltf`
+/// (`save_gltf`).
+///
+/// # Errors
+/// [`Error::Io`] naming the file; [`Error::UnknownFormat`] for another
+/// extension.
+pub fn save_mesh(mesh: &Mesh, path: &Path) -> Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("obj") => save_obj(mesh, path),
+        #[cfg(feature = "gltf")]
+        Some("glb" | "gltf") => save_gltf(mesh, path),
+        _ => Err(Error::UnknownFormat {
+            file: path.to_owned(),
+            message: "writes .obj, .glb and .gltf (by extension)".into(),
+        }),
+    }
+}
+
 /// Writes `mesh` as OBJ text to `path`: one `v` line per point (vertices
 /// split at a seam share it, so the seam reads back as one), `vt` and `vn`
 /// lines when the mesh has texture coordinates or normals (one per
