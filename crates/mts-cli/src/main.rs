@@ -344,9 +344,9 @@ struct MeshSource {
     #[arg(long)]
     weld: bool,
     /// Read normals, texture coordinates, colours and the texture (OBJ
-    /// vertices are split where a position has several); `simplify` keeps
-    /// every seam and writes them with `-o`. Models (`build`, `extract`,
-    /// ...) do not carry properties yet.
+    /// vertices are split where a position has several); every LoD keeps
+    /// every seam, and `simplify -o`, `build` and `extract -o` keep them.
+    /// The baselines (`encode`, `compare`) do not carry them yet.
     #[arg(long)]
     properties: bool,
 }
@@ -370,16 +370,16 @@ impl MeshSource {
                 return Ok((path.display().to_string(), model));
             }
         }
-        let (name, mesh, _) = self.load_for_model()?;
+        let (name, mesh, _) = self.load()?;
         let (model, _, _) = build_with_bar(&mesh, &Default::default());
         Ok((name, model))
     }
 
-    /// [`MeshSource::load`] for the commands that build models, cluster
-    /// trees or scenes, which do not carry properties yet.
+    /// [`MeshSource::load`] for the commands that build the baselines,
+    /// cluster trees or scenes, which do not carry properties yet.
     fn load_for_model(&self) -> Result<(String, Mesh, CleanReport)> {
         if self.properties {
-            bail!("models do not carry vertex properties yet: drop --properties");
+            bail!("the baselines and scenes do not carry vertex properties yet: drop --properties");
         }
         self.load()
     }
@@ -862,7 +862,7 @@ fn run(cli: &Cli) -> Result<()> {
 const PROGRESS_MIN_TRIANGLES: usize = 200_000;
 
 fn build(args: &BuildArgs) -> Result<()> {
-    let (name, mesh, _) = args.source.load_for_model()?;
+    let (name, mesh, _) = args.source.load()?;
     let options = args.pipeline_options();
     let (model, _, t) = build_with_bar(&mesh, &options);
     let bytes = model.to_bytes();
@@ -914,7 +914,7 @@ fn build(args: &BuildArgs) -> Result<()> {
             st.memory_bytes as f64 / 1e6
         );
         println!(
-            "  file      {} bytes = {:.2} x raw ({} bytes: 12 per vertex + 12 per triangle) -> {}",
+            "  file      {} bytes = {:.2} x raw ({} bytes: 12 per vertex and its properties, 12 per triangle) -> {}",
             bytes.len(),
             bytes.len() as f64 / model.raw_bytes() as f64,
             model.raw_bytes(),
@@ -1112,7 +1112,9 @@ fn extract(args: &ExtractArgs) -> Result<()> {
         let mesh = Mesh {
             positions: model.positions().to_vec(),
             triangles: ex.triangles(),
-            properties: Default::default(),
+            // The input vertices' (a model with properties has no created
+            // vertices: endpoint placement).
+            properties: model.properties().clone(),
         };
         mts::mesh::io::save_mesh(&mesh, out)?;
     }

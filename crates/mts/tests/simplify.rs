@@ -481,6 +481,7 @@ fn against_meshoptimizer(
     let q = peers::quality::compare(mesh, c, c.lod_for_ratio(ratio), 50_000, |lod| Mesh {
         positions: mesh.positions.clone(),
         triangles: c.triangles_at(mesh, lod),
+        properties: Default::default(),
     });
     (q.ours.distance, q.meshopt.distance, q.ours.triangle_count)
 }

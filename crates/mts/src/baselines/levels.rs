@@ -52,12 +52,18 @@ impl Levels {
     ///
     /// # Errors
     /// [`Error::InvalidArgument`] when `collapses` uses optimal placement
-    /// (the baselines keep endpoints, as the MTS model does) or was not
-    /// computed on `mesh`.
+    /// (the baselines keep endpoints, as the MTS model does), moves several
+    /// vertices per step (a mesh with seams: the baselines do not carry
+    /// properties yet) or was not computed on `mesh`.
     pub(crate) fn new(mesh: &Mesh, collapses: &Collapses) -> Result<Levels> {
         if collapses.is_optimal_placement() {
             return Err(Error::InvalidArgument(
                 "the baselines need an endpoint-placement contraction sequence".into(),
+            ));
+        }
+        if collapses.has_companions() {
+            return Err(Error::InvalidArgument(
+                "the baselines do not carry vertex properties yet: a mesh with seams".into(),
             ));
         }
         let n = mesh.vertex_count();

@@ -224,6 +224,7 @@ pub fn build_with_progress(
     }
     let model = MtsModel {
         positions: ctx.positions,
+        properties: mesh.properties.clone(),
         strip_nodes: graphs.strip_nodes,
         strip_begins: graphs.strip_begins,
         band_strips: graphs.band_strips,
@@ -1025,7 +1026,7 @@ mod tests {
                 error: 0.0,
             })
             .collect();
-        let counts = crate::model::format::replay_counts(mesh, &steps, false);
+        let counts = crate::model::format::replay_counts(mesh, &steps, false, &[]);
         let collapses = Collapses::new(mesh.vertex_count(), steps, counts, Vec::new());
         let options = BuildOptions {
             band_slack: f64::INFINITY,

@@ -27,6 +27,18 @@
 //!   varint of its difference from the previous index.
 //! - `STEP`: per contraction: removed (varint), kept (varint), error (f32).
 //!
+//! Version 2 adds two sections after these, and is written only for a
+//! model that needs them (a mesh with properties or seams), so files of
+//! positions only stay version 1, byte for byte; both versions load:
+//! - `PROP`: flags u8 (1 normals, 2 texture coordinates, 4 colours, 8
+//!   position ids, 16 texture), then per input vertex `3 × f32` normals,
+//!   `2 × f32` UVs, `4 × f32` colours, a varint position id, as flagged;
+//!   then the texture: kind u8 (0 a file path, 1 embedded), for a path its
+//!   UTF-8 bytes (varint length first), for embedded the MIME type and the
+//!   image bytes (each with a varint length).
+//! - `CMPN`: per step, its number of companion moves (varint), then each
+//!   move's removed and kept vertex (varints).
+//!
 //! Every count is checked against the bytes that must hold it before
 //! anything is allocated, so a corrupt file costs at most its own size.
 
@@ -40,10 +52,12 @@ use std::path::{Path, PathBuf};
 
 /// The file's first bytes.
 pub const MAGIC: &[u8; 8] = b"MTSMODEL";
-/// The version this crate writes and reads.
-pub const VERSION: u32 = 1;
+/// The newest version this crate writes and reads (it reads 1 too).
+pub const VERSION: u32 = 2;
 const HEADER_LEN: usize = 32;
-const TAGS: [&[u8; 4]; 4] = [b"META", b"POSI", b"STRP", b"STEP"];
+const TAGS: [&[u8; 4]; 6] = [b"META", b"POSI", b"STRP", b"STEP", b"PROP", b"CMPN"];
+/// Sections of a version-1 file.
+const V1_SECTIONS: usize = 4;
 
 impl MtsModel {
     /// The model as `.mts` bytes.
@@ -95,16 +109,34 @@ impl MtsModel {
             step.extend_from_slice(&s.error.to_le_bytes());
         }
 
+        let mut payloads = vec![meta, posi, strp, step];
+        let version = if self.properties.is_empty() && !c.has_companions() {
+            1
+        } else {
+            payloads.push(properties_payload(&self.properties));
+            let mut cmpn = Vec::new();
+            for i in 0..c.max_lod() {
+                let moves: Vec<(u32, u32)> = c.moves(i).skip(1).collect();
+                put_varint(&mut cmpn, moves.len() as u64);
+                for (r, k) in moves {
+                    put_varint(&mut cmpn, u64::from(r));
+                    put_varint(&mut cmpn, u64::from(k));
+                }
+            }
+            payloads.push(cmpn);
+            2
+        };
         let mut body = Vec::new();
-        for (tag, payload) in TAGS.iter().zip([meta, posi, strp, step]) {
+        let sections = payloads.len();
+        for (tag, payload) in TAGS.iter().zip(payloads) {
             body.extend_from_slice(*tag);
             body.extend_from_slice(&(payload.len() as u64).to_le_bytes());
             body.extend_from_slice(&payload);
         }
         let mut out = Vec::with_capacity(HEADER_LEN + body.len());
         out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&(TAGS.len() as u32).to_le_bytes());
+        out.extend_from_slice(&(version as u32).to_le_bytes());
+        out.extend_from_slice(&(sections as u32).to_le_bytes());
         out.extend_from_slice(&((HEADER_LEN + body.len()) as u64).to_le_bytes());
         out.extend_from_slice(&crate::checksum::fnv1a64(&body).to_le_bytes());
         out.extend_from_slice(&body);
@@ -147,6 +179,7 @@ impl MtsModel {
             &recipe.collapses,
             &recipe.options,
         );
+        debug_assert_eq!(model.properties, recipe.mesh.properties);
         model.validate().map_err(|e| {
             parse_error(
                 file,
@@ -304,17 +337,27 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         u64::from_le_bytes(a)
     };
     let version = u32_at(8);
-    if version != VERSION {
+    if !(1..=VERSION).contains(&version) {
         return Err(Error::UnknownFormat {
             file: file.to_owned(),
-            message: format!("byte 8: .mts version {version}; this build reads version {VERSION}"),
+            message: format!(
+                "byte 8: .mts version {version}; this build reads versions 1 to {VERSION}"
+            ),
         });
     }
     let header = |byte, m: String| parse_error(file, byte, "header", m);
-    if u32_at(12) as usize != TAGS.len() {
+    let section_count = if version == 1 {
+        V1_SECTIONS
+    } else {
+        TAGS.len()
+    };
+    if u32_at(12) as usize != section_count {
         return Err(header(
             12,
-            format!("{} sections, expected {}", u32_at(12), TAGS.len()),
+            format!(
+                "{} sections, expected {section_count} in version {version}",
+                u32_at(12)
+            ),
         ));
     }
     if u64_at(16) != bytes.len() as u64 {
@@ -336,7 +379,7 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         ));
     }
     // Split into sections.
-    let mut sections = Vec::with_capacity(TAGS.len());
+    let mut sections = Vec::with_capacity(section_count);
     let mut top = Reader {
         bytes: body,
         pos: 0,
@@ -344,7 +387,7 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         section: "section table",
         file: file.to_owned(),
     };
-    for (i, tag) in TAGS.iter().enumerate() {
+    for (i, tag) in TAGS.iter().take(section_count).enumerate() {
         let at = top.pos;
         let got = top.take(4)?.to_vec();
         if got != *tag {
@@ -375,6 +418,8 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         });
     }
     top.finish()?;
+    let mut extra = sections.split_off(V1_SECTIONS).into_iter();
+    let (prop, cmpn) = (extra.next(), extra.next());
     let [mut meta, mut posi, mut strp, mut step]: [Reader; 4] = sections
         .try_into()
         .map_err(|_| parse_error(file, HEADER_LEN, "section table", "section count".into()))?;
@@ -481,11 +526,14 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         vertices as u32,
     )
     .map_err(|e| strp.error(e.to_string()))?;
-    let mesh = Mesh {
+    let mut mesh = Mesh {
         positions: positions[..vertices].to_vec(),
         triangles: strips.triangles(),
         properties: Default::default(),
     };
+    if let Some(mut prop) = prop {
+        mesh.properties = read_properties(&mut prop, &mesh.positions)?;
+    }
     if mesh.triangles.is_empty() {
         return Err(strp.error("the strips draw no triangle"));
     }
@@ -530,9 +578,14 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         });
     }
     step.finish()?;
+    let companions = match cmpn {
+        Some(mut r) => read_companions(&mut r, &list, vertices, optimal)?,
+        None => Vec::new(),
+    };
     let appended_positions = positions[vertices..].to_vec();
-    let counts = replay_counts(&mesh, &list, optimal);
-    let collapses = Collapses::new(vertices, list, counts, appended_positions);
+    let counts = replay_counts(&mesh, &list, optimal, &companions);
+    let collapses =
+        Collapses::with_companions(vertices, list, counts, appended_positions, companions);
     Ok(Parsed {
         mesh,
         strips,
@@ -549,7 +602,181 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
     })
 }
 
-const SECTION_NAMES: [&str; 4] = ["META", "POSI", "STRP", "STEP"];
+const SECTION_NAMES: [&str; 6] = ["META", "POSI", "STRP", "STEP", "PROP", "CMPN"];
+
+/// The `PROP` section of `p`.
+fn properties_payload(p: &crate::mesh::Properties) -> Vec<u8> {
+    use crate::mesh::Texture;
+    let flags = u8::from(p.normals.is_some())
+        | u8::from(p.uvs.is_some()) << 1
+        | u8::from(p.colors.is_some()) << 2
+        | u8::from(!p.position_ids.is_empty()) << 3
+        | u8::from(p.texture.is_some()) << 4;
+    let mut out = vec![flags];
+    let mut floats = |xs: &[f32]| {
+        for x in xs {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    };
+    for n in p.normals.iter().flatten() {
+        floats(&n.to_array());
+    }
+    for t in p.uvs.iter().flatten() {
+        floats(&t.to_array());
+    }
+    for c in p.colors.iter().flatten() {
+        floats(&c.to_array());
+    }
+    for &id in &p.position_ids {
+        put_varint(&mut out, u64::from(id));
+    }
+    let bytes = |b: &[u8], out: &mut Vec<u8>| {
+        put_varint(out, b.len() as u64);
+        out.extend_from_slice(b);
+    };
+    match &p.texture {
+        Some(Texture::File(path)) => {
+            out.push(0);
+            bytes(path.to_string_lossy().as_bytes(), &mut out);
+        }
+        Some(Texture::Embedded { mime, bytes: image }) => {
+            out.push(1);
+            bytes(mime.as_bytes(), &mut out);
+            bytes(image, &mut out);
+        }
+        None => {}
+    }
+    out
+}
+
+/// Reads and checks the `PROP` section for a mesh with `positions`.
+fn read_properties(r: &mut Reader<'_>, positions: &[Vec3]) -> Result<crate::mesh::Properties> {
+    use crate::mesh::{Properties, Texture};
+    use glam::{Vec2, Vec4};
+    let n = positions.len();
+    let at = r.pos;
+    let flags = r.u8()?;
+    if flags >= 32 {
+        r.pos = at;
+        return Err(r.error(format!("property flags {flags:#x}: unknown bits")));
+    }
+    let floats_per_vertex = 3 * usize::from(flags & 1 != 0)
+        + 2 * usize::from(flags & 2 != 0)
+        + 4 * usize::from(flags & 4 != 0);
+    if floats_per_vertex * 4 * n > r.remaining() {
+        return Err(r.error(format!(
+            "{} bytes left, {} needed for the property streams of {n} vertices",
+            r.remaining(),
+            floats_per_vertex * 4 * n
+        )));
+    }
+    let mut p = Properties::default();
+    let read = |r: &mut Reader<'_>, k: usize| -> Result<Vec<[f32; 4]>> {
+        (0..n)
+            .map(|_| {
+                let mut v = [0f32; 4];
+                for x in v.iter_mut().take(k) {
+                    *x = r.f32()?;
+                }
+                Ok(v)
+            })
+            .collect()
+    };
+    if flags & 1 != 0 {
+        p.normals = Some(
+            read(r, 3)?
+                .iter()
+                .map(|v| Vec3::new(v[0], v[1], v[2]))
+                .collect(),
+        );
+    }
+    if flags & 2 != 0 {
+        p.uvs = Some(read(r, 2)?.iter().map(|v| Vec2::new(v[0], v[1])).collect());
+    }
+    if flags & 4 != 0 {
+        p.colors = Some(read(r, 4)?.iter().map(|v| Vec4::from_array(*v)).collect());
+    }
+    if flags & 8 != 0 {
+        if n > r.remaining() {
+            return Err(r.error(format!("{} bytes left for {n} position ids", r.remaining())));
+        }
+        p.position_ids = (0..n)
+            .map(|_| r.count("position id", n as u64).map(|v| v as u32))
+            .collect::<Result<_>>()?;
+    }
+    if flags & 16 != 0 {
+        let kind = r.u8()?;
+        let bytes = |r: &mut Reader<'_>, what: &str| -> Result<Vec<u8>> {
+            let len = r.count(what, r.remaining() as u64)?;
+            Ok(r.take(len)?.to_vec())
+        };
+        p.texture = Some(match kind {
+            0 => Texture::File(
+                String::from_utf8_lossy(&bytes(r, "texture path length")?)
+                    .into_owned()
+                    .into(),
+            ),
+            1 => Texture::Embedded {
+                mime: String::from_utf8_lossy(&bytes(r, "MIME type length")?).into_owned(),
+                bytes: bytes(r, "texture length")?,
+            },
+            k => {
+                r.pos -= 1;
+                return Err(r.error(format!("texture kind {k}, not 0 (file) or 1 (embedded)")));
+            }
+        });
+    }
+    let start = r.base;
+    r.finish()?;
+    p.validate(positions)
+        .map_err(|m| parse_error(&r.file, start, "PROP", m))?;
+    Ok(p)
+}
+
+/// Reads and checks the `CMPN` section: each step's companion moves,
+/// replayed with the steps so that no vertex is removed twice or used
+/// after its removal.
+fn read_companions(
+    r: &mut Reader<'_>,
+    steps: &[Collapse],
+    vertices: usize,
+    optimal: bool,
+) -> Result<Vec<Vec<(u32, u32)>>> {
+    let mut removed_at = vec![false; vertices];
+    let mut out = Vec::with_capacity(steps.len().min(r.remaining()));
+    for (i, s) in steps.iter().enumerate() {
+        if !optimal {
+            // Checked against the earlier steps' companions too.
+            if removed_at[s.removed as usize] || removed_at[s.kept as usize] {
+                return Err(r.error(format!(
+                    "step {i} uses a vertex an earlier companion removed"
+                )));
+            }
+            removed_at[s.removed as usize] = true;
+        }
+        let count = r.count("companion count", (r.remaining() / 2) as u64)?;
+        if count > 0 && optimal {
+            return Err(r.error(format!("step {i}: companions with optimal placement")));
+        }
+        let mut moves = Vec::with_capacity(count);
+        for _ in 0..count {
+            let at = r.pos;
+            let removed = r.count("removed vertex", vertices as u64 - 1)?;
+            let kept = r.count("kept vertex", vertices as u64 - 1)?;
+            if removed == kept || removed_at[removed] || removed_at[kept] {
+                r.pos = at;
+                return Err(r.error(format!(
+                    "step {i}: companion ({removed}, {kept}) uses a removed vertex"
+                )));
+            }
+            removed_at[removed] = true;
+            moves.push((removed as u32, kept as u32));
+        }
+        out.push(moves);
+    }
+    r.finish()?;
+    Ok(out)
+}
 
 fn flag(r: &mut Reader<'_>, what: &str) -> Result<bool> {
     match r.u8()? {
@@ -565,7 +792,12 @@ fn flag(r: &mut Reader<'_>, what: &str) -> Result<bool> {
 /// The triangle count after each step of a checked sequence: triangles of
 /// each vertex in per-vertex lists, moved onto the target as it replaces
 /// the vertex. O(triangles + moved entries).
-pub(crate) fn replay_counts(mesh: &Mesh, steps: &[Collapse], optimal: bool) -> Vec<u32> {
+pub(crate) fn replay_counts(
+    mesh: &Mesh,
+    steps: &[Collapse],
+    optimal: bool,
+    companions: &[Vec<(u32, u32)>],
+) -> Vec<u32> {
     let total = mesh.vertex_count() + if optimal { steps.len() } else { 0 };
     let mut tris = mesh.triangles.clone();
     let mut of: Vec<Vec<u32>> = vec![Vec::new(); total];
@@ -578,18 +810,17 @@ pub(crate) fn replay_counts(mesh: &Mesh, steps: &[Collapse], optimal: bool) -> V
     let mut count = tris.len() as u32;
     let mut counts = Vec::with_capacity(steps.len() + 1);
     counts.push(count);
+    let mut moves = Vec::new();
     for (i, s) in steps.iter().enumerate() {
-        let target = if optimal {
-            (mesh.vertex_count() + i) as u32
+        moves.clear();
+        if optimal {
+            let target = (mesh.vertex_count() + i) as u32;
+            moves.extend([(s.removed, target), (s.kept, target)]);
         } else {
-            s.kept
-        };
-        let moved: &[u32] = if optimal {
-            &[s.removed, s.kept]
-        } else {
-            &[s.removed]
-        };
-        for &v in moved {
+            moves.push((s.removed, s.kept));
+        }
+        moves.extend(companions.get(i).into_iter().flatten().copied());
+        for &(v, target) in &moves {
             let list = std::mem::take(&mut of[v as usize]);
             for &t in &list {
                 if !alive[t as usize] {

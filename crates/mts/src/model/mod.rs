@@ -65,6 +65,10 @@ pub const NODE_MASK: u32 = RESTART - 1;
 #[derive(Debug, Clone, PartialEq)]
 pub struct MtsModel {
     pub(crate) positions: Vec<Vec3>,
+    /// The input vertices' properties (normals, UVs, colours, texture,
+    /// position ids); empty for a mesh of positions only. A LoD draws
+    /// input vertices (endpoint placement), so they serve every LoD.
+    pub(crate) properties: crate::mesh::Properties,
     pub(crate) strip_nodes: Vec<u32>,
     pub(crate) strip_begins: Vec<u32>,
     /// Per beginning: the first node (global index) or [`END`] for "the
@@ -182,8 +186,14 @@ impl MtsModel {
         crate::Mesh {
             positions: self.positions[..self.recipe.collapses.vertex_count()].to_vec(),
             triangles: self.recipe.strips.triangles(),
-            properties: Default::default(),
+            properties: self.properties.clone(),
         }
+    }
+
+    /// The input vertices' properties, uploaded once for every LoD.
+    #[must_use]
+    pub fn properties(&self) -> &crate::mesh::Properties {
+        &self.properties
     }
 
     /// Number of bands (strip sets stripified afresh at a LoD).
@@ -230,16 +240,22 @@ impl MtsModel {
             nodes: self.node_vertex.len(),
             arcs: self.arc_target.len(),
             begins: self.begin_node.len(),
-            memory_bytes: 4 * words + 12 * self.positions.len(),
+            memory_bytes: 4 * words
+                + 12 * self.positions.len()
+                + self.properties.bytes_per_vertex() * self.recipe.collapses.vertex_count()
+                + 4 * self.properties.position_ids.len(),
         }
     }
 
     /// Bytes of the raw input mesh with 32-bit indices: 12 per vertex
-    /// (three `f32`) and 12 per triangle (three `u32`). The reference of the
-    /// `.mts` size target and of `mts build --json`'s `raw_bytes`.
+    /// (three `f32`) plus its properties' bytes
+    /// ([`crate::mesh::Properties::bytes_per_vertex`]), and 12 per triangle
+    /// (three `u32`). The reference of the `.mts` size target and of
+    /// `mts build --json`'s `raw_bytes`.
     #[must_use]
     pub fn raw_bytes(&self) -> usize {
-        12 * self.recipe.collapses.vertex_count() + 12 * self.triangle_count(0)
+        (12 + self.properties.bytes_per_vertex()) * self.recipe.collapses.vertex_count()
+            + 12 * self.triangle_count(0)
     }
 
     /// Bytes of the raw input mesh with 16-bit indices: 12 per vertex and 6

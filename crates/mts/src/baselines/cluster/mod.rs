@@ -90,7 +90,7 @@ impl ClusterTree {
             .iter()
             .map(|(_, s)| ((f64::from(*s) / scale) as f32).min(f32::MAX))
             .collect();
-        let counts = crate::model::format::replay_counts(mesh, &steps, false);
+        let counts = crate::model::format::replay_counts(mesh, &steps, false, &[]);
         let collapses = Collapses::new(mesh.vertex_count(), steps, counts, Vec::new());
         let levels = Levels::new(mesh, &collapses)?;
         let runtime = ProgressiveMesh::from_levels(mesh, &levels);
