@@ -56,7 +56,8 @@ pub const MAX_FILE_BYTES: u64 = 4 << 30;
 pub enum Format {
     /// Wavefront OBJ (geometry only; materials are ignored).
     Obj,
-    /// Stanford PLY, ascii or binary.
+    /// Stanford PLY, ascii or binary, with vertex normals, texture
+    /// coordinates and colours.
     Ply,
 }
 
