@@ -1,11 +1,12 @@
-//! The PLY reader: every encoding, skipped properties, polygons, triangle
-//! strips, vertex property streams (normals, texture coordinates, colours)
-//! under each of their names and types, and every error case the loader
-//! promises a clear message for.
+//! The PLY reader and writer: every encoding, skipped properties,
+//! polygons, triangle strips, vertex property streams (normals, texture
+//! coordinates, colours) under each of their names and types, the round
+//! trip through `save_ply`, and every error case the loader promises a
+//! clear message for.
 
 use glam::{Vec2, Vec3, Vec4};
-use mts::mesh::io::{load, parse_ply, LoadOptions};
-use mts::mesh::{clean, CleanOptions, Properties, RawMesh, Texture};
+use mts::mesh::io::{load, parse_ply, save_ply, LoadOptions};
+use mts::mesh::{clean, CleanOptions, Mesh, Properties, RawMesh, Texture};
 use mts::Error;
 use std::path::{Path, PathBuf};
 
@@ -597,6 +598,142 @@ property float y\nproperty float z\nelement face 1\nproperty list uchar int vert
     assert_eq!(
         place_of(&bytes),
         at(None, Some(data as u64 + 16), Some("vertex"), Some(1))
+    );
+}
+
+/// A square of two triangles with every stream and a seam: vertices 2
+/// and 4 are one point with different texture coordinates.
+///
+/// ```text
+///  3 --- 2,4
+///  |   /  |
+///  | /    |
+///  0 ---- 1
+/// ```
+fn square_with_streams(texture: &Path) -> Mesh {
+    let raw = RawMesh {
+        positions: vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.5),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.5),
+        ],
+        triangles: vec![[0, 1, 2], [0, 4, 3]],
+        degenerate_in_source: 0,
+        properties: Properties {
+            normals: Some(
+                (0..5)
+                    .map(|i| Vec3::new(0.1 * i as f32, -0.3, 1.0))
+                    .collect(),
+            ),
+            uvs: Some(
+                (0..5)
+                    .map(|i| Vec2::new(0.5 * i as f32, 1.0 - 0.125 * i as f32))
+                    .collect(),
+            ),
+            colors: Some(
+                (0..5)
+                    .map(|i| Vec4::new(0.1 * i as f32, 0.33, 1.0, 0.7))
+                    .collect(),
+            ),
+            position_ids: vec![0, 1, 2, 3, 2],
+            texture: Some(Texture::File(texture.to_owned())),
+        },
+    };
+    clean(raw, CleanOptions::default(), "square").unwrap().0
+}
+
+/// Whether `a` and `b` have the same colours within 1/255 (the writer's
+/// `uchar`) and the same normals within `normal_error`; returns `b` with
+/// `a`'s colours and normals for an exact comparison of the rest.
+fn close_streams(a: &Properties, b: &Properties, normal_error: f32) -> Properties {
+    let (ca, cb) = (a.colors.as_ref(), b.colors.as_ref());
+    assert_eq!(ca.map(Vec::len), cb.map(Vec::len));
+    for (x, y) in ca.into_iter().flatten().zip(cb.into_iter().flatten()) {
+        assert!((*x - *y).abs().max_element() <= 1.0 / 255.0, "{x} {y}");
+    }
+    let (na, nb) = (a.normals.as_ref(), b.normals.as_ref());
+    assert_eq!(na.map(Vec::len), nb.map(Vec::len));
+    for (x, y) in na.into_iter().flatten().zip(nb.into_iter().flatten()) {
+        assert!((*x - *y).abs().max_element() <= normal_error, "{x} {y}");
+    }
+    Properties {
+        colors: a.colors.clone(),
+        normals: a.normals.clone(),
+        ..b.clone()
+    }
+}
+
+#[test]
+fn save_ply_reads_back_to_the_same_mesh() {
+    let folder = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let path = folder.join("save_ply_streams.ply");
+    let mesh = square_with_streams(&folder.join("checker.png"));
+    assert_eq!(mesh.properties.position_ids, vec![0, 1, 2, 3, 2]);
+    save_ply(&mesh, &path).unwrap();
+    // The reader gives back every value (normals to the bit), but not the
+    // position ids, which PLY has no place for.
+    let raw = parse_ply(&std::fs::read(&path).unwrap(), &path).unwrap();
+    assert_eq!(raw.positions, mesh.positions);
+    assert_eq!(raw.triangles, mesh.triangles);
+    let read = close_streams(&mesh.properties, &raw.properties, 0.0);
+    let want = Properties {
+        position_ids: Vec::new(),
+        ..mesh.properties.clone()
+    };
+    assert_eq!(read, want);
+    // Cleaned with the weld, the seam's two vertices are one point again;
+    // clean normalises normals again (a change in the last bit).
+    let weld = CleanOptions { weld: true };
+    let (again, report) = clean(raw.clone(), weld, "again").unwrap();
+    assert_eq!(report.welded, 0);
+    assert_eq!(again.positions, mesh.positions);
+    assert_eq!(again.triangles, mesh.triangles);
+    let read = close_streams(&mesh.properties, &again.properties, 1e-6);
+    assert_eq!(read, mesh.properties);
+    let bytes = std::fs::read(&path).unwrap();
+    let text = String::from_utf8_lossy(
+        &bytes[..bytes.windows(10).position(|w| w == b"end_header").unwrap()],
+    );
+    assert!(
+        text.contains("\ncomment TextureFile checker.png\n"),
+        "{text}"
+    );
+    assert!(
+        text.contains("\nproperty float texture_u\nproperty float texture_v\n"),
+        "{text}"
+    );
+
+    // Positions only, a closed surface: the same bits.
+    let sphere = mts::mesh::generate::icosphere(12, 0.1, 7);
+    let path = folder.join("save_ply_sphere.ply");
+    save_ply(&sphere, &path).unwrap();
+    let raw = parse_ply(&std::fs::read(&path).unwrap(), &path).unwrap();
+    assert_eq!(raw.properties, Properties::default());
+    assert_eq!(
+        clean(raw, CleanOptions::default(), "again").unwrap().0,
+        sphere
+    );
+}
+
+#[test]
+fn save_ply_refuses_invalid_meshes_and_unwritable_textures() {
+    let folder = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let path = folder.join("save_ply_refused.ply");
+    let mut mesh = square_with_streams(Path::new("t.png"));
+    mesh.properties.uvs.as_mut().unwrap().pop();
+    assert!(matches!(save_ply(&mesh, &path), Err(Error::Invalid(_))));
+    let mesh = square_with_streams(&folder.join("two\nlines.png"));
+    assert!(matches!(
+        save_ply(&mesh, &path),
+        Err(Error::InvalidArgument(_))
+    ));
+    let mesh = square_with_streams(Path::new("t.png"));
+    let e = save_ply(&mesh, Path::new("/nonexistent/m.ply")).unwrap_err();
+    assert!(
+        matches!(&e, Error::Io { file, .. } if file == Path::new("/nonexistent/m.ply")),
+        "{e}"
     );
 }
 

@@ -1,4 +1,6 @@
-//! Reading meshes from files: OBJ and PLY, each with its own reader.
+//! Reading meshes from files, OBJ and PLY, each with its own reader, and
+//! writing them ([`save_obj`]: positions only; [`save_ply`]: with normals,
+//! texture coordinates, colours and a texture file's name).
 //!
 //! Every loader returns a [`RawMesh`] whose positions are finite and whose
 //! indices are in range, or an error naming the file and the place; [`load`]
@@ -9,6 +11,7 @@ mod ply;
 
 pub use obj::parse_obj;
 pub use ply::parse_ply;
+pub use ply::save_ply;
 
 use super::{clean, CleanOptions, CleanReport, Mesh, RawMesh};
 use crate::error::{Error, Result};

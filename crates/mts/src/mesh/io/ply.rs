@@ -1,4 +1,5 @@
-//! Stanford PLY reader: `ascii`, `binary_little_endian`, `binary_big_endian`.
+//! Stanford PLY reader (`ascii`, `binary_little_endian`,
+//! `binary_big_endian`) and writer (binary little endian).
 //!
 //! Hand-written rather than built on `ply-rs-bw` so that every error names
 //! the file, line or byte offset, element and index, and so that no
@@ -31,7 +32,7 @@
 //! included.
 
 use crate::error::{Error, Place, Result};
-use crate::mesh::{RawMesh, Texture};
+use crate::mesh::{Mesh, RawMesh, Texture};
 use glam::{Vec2, Vec3, Vec4};
 use std::path::Path;
 
@@ -929,5 +930,108 @@ fn push_strip(list: &[i64], run: &mut Vec<u32>, raw: &mut RawMesh) {
         crate::encoding::decode_run(run, &mut raw.triangles);
         let windows = run.len().saturating_sub(2);
         raw.degenerate_in_source += windows - (raw.triangles.len() - before);
+    }
+}
+
+/// Writes `mesh` as binary little-endian PLY to `path`: `x y z`, then the
+/// streams the mesh has, `nx ny nz` and `texture_u texture_v` (the names
+/// MeshLab writes and trimesh tries first) as `float`, `red green blue
+/// alpha` as `uchar` (each channel times 255, rounded); faces as `property
+/// list uchar uint vertex_indices`. A [`Texture::File`] is named by a
+/// `comment TextureFile` line, relative to `path`'s folder when inside it,
+/// else absolute. PLY has no place for an embedded texture or for
+/// position ids, so neither is written: [`parse_ply`] reads the file back
+/// to the same mesh with colours within 1/510, and split vertices come
+/// back as one point when the reader welds ([`crate::mesh::CleanOptions`]).
+///
+/// # Errors
+/// [`Error::Invalid`] when `mesh` breaks an invariant ([`Mesh::validate`]),
+/// [`Error::InvalidArgument`] for a texture path that is not UTF-8 or
+/// holds a line break, [`Error::Io`] naming the file.
+///
+/// Cost: O(V + T), one buffered write.
+pub fn save_ply(mesh: &Mesh, path: &Path) -> Result<()> {
+    use std::fmt::Write as _;
+    use std::io::Write as _;
+    fn put(record: &mut Vec<u8>, values: &[f32]) {
+        for x in values {
+            record.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    mesh.validate()?;
+    let streams = &mesh.properties;
+    let mut header = String::from("ply\nformat binary_little_endian 1.0\ncomment written by mts\n");
+    if let Some(Texture::File(file)) = &streams.texture {
+        let _ = writeln!(header, "comment TextureFile {}", texture_name(file, path)?);
+    }
+    let _ = write!(
+        header,
+        "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n",
+        mesh.vertex_count()
+    );
+    if streams.normals.is_some() {
+        header += "property float nx\nproperty float ny\nproperty float nz\n";
+    }
+    if streams.uvs.is_some() {
+        header += "property float texture_u\nproperty float texture_v\n";
+    }
+    if streams.colors.is_some() {
+        header +=
+            "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
+    }
+    let _ = write!(
+        header,
+        "element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        mesh.triangle_count()
+    );
+
+    let io = |source| Error::Io {
+        file: path.to_owned(),
+        source,
+    };
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    w.write_all(header.as_bytes()).map_err(io)?;
+    let mut record: Vec<u8> = Vec::with_capacity(48);
+    for (v, p) in mesh.positions.iter().enumerate() {
+        record.clear();
+        put(&mut record, &p.to_array());
+        if let Some(normals) = &streams.normals {
+            put(&mut record, &normals[v].to_array());
+        }
+        if let Some(uvs) = &streams.uvs {
+            put(&mut record, &uvs[v].to_array());
+        }
+        if let Some(colors) = &streams.colors {
+            let c = colors[v].to_array();
+            record.extend(c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8));
+        }
+        w.write_all(&record).map_err(io)?;
+    }
+    for t in &mesh.triangles {
+        record.clear();
+        record.push(3);
+        for i in t {
+            record.extend_from_slice(&i.to_le_bytes());
+        }
+        w.write_all(&record).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
+
+/// How a `comment TextureFile` line names `texture` for a PLY at `ply`.
+fn texture_name(texture: &Path, ply: &Path) -> Result<String> {
+    let folder = ply.parent().unwrap_or(Path::new(""));
+    let name = match texture.strip_prefix(folder) {
+        Ok(inside) => inside.to_owned(),
+        Err(_) => std::path::absolute(texture).map_err(|e| {
+            Error::InvalidArgument(format!("texture path {}: {e}", texture.display()))
+        })?,
+    };
+    match name.to_str() {
+        Some(s) if !s.contains(['\n', '\r']) && !s.trim().is_empty() => Ok(s.to_owned()),
+        _ => Err(Error::InvalidArgument(format!(
+            "texture path {} cannot be written on a PLY header line (not UTF-8, empty, or a line break)",
+            texture.display()
+        ))),
     }
 }
