@@ -1,10 +1,11 @@
-//! Reading meshes from files, OBJ and PLY, each with its own reader, and
-//! writing them ([`save_obj`]: positions only; [`save_ply`]: with normals,
-//! texture coordinates, colours and a texture file's name).
+//! Reading meshes from files: OBJ and PLY, each with its own reader.
 //!
 //! Every loader returns a [`RawMesh`] whose positions are finite and whose
 //! indices are in range, or an error naming the file and the place; [`load`]
 //! then cleans it (see [`crate::mesh::clean`]).
+//!
+//! Writing: [`save_obj`], and [`save_ply`] (binary, with the mesh's normals,
+//! texture coordinates, colours and texture file name).
 
 mod obj;
 mod ply;

@@ -14,7 +14,7 @@
 //!
 //! - normals `nx ny nz`;
 //! - texture coordinates `texture_u texture_v`, `u v`, `s t` or
-//!   `texture_s texture_t` (the first pair declared, in that order), `v`
+//!   `texture_s texture_t` (the first of these pairs declared whole), `v`
 //!   up as in OBJ;
 //! - colours `red green blue [alpha]`, `r g b [a]` or `diffuse_red
 //!   diffuse_green diffuse_blue [diffuse_alpha]`: integer types divided by
@@ -23,8 +23,8 @@
 //!
 //! A stream is read only when every component it needs is declared: a lone
 //! `nx`, or `u` without `v`, is skipped like any unknown property. A
-//! component declared as a list is an error. A header line `comment
-//! TextureFile name.png` (MeshLab writes it) names the texture the
+//! component declared as a list is an error. The first header line
+//! `comment TextureFile name.png` (MeshLab writes it) names the texture the
 //! coordinates sample, resolved against the PLY file's folder; it is kept
 //! only with texture coordinates. Per-face properties (colours, normals,
 //! MeshLab's per-corner `texcoord` lists) are ignored. Every other element
