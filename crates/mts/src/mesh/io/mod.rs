@@ -4,6 +4,9 @@
 //! Every loader returns a [`RawMesh`] whose positions are finite and whose
 //! indices are in range, or an error naming the file and the place; [`load`]
 //! then cleans it (see [`crate::mesh::clean`]).
+//!
+//! Writing: [`save_obj`], and [`save_ply`] (binary, with the mesh's normals,
+//! texture coordinates, colours and texture file name).
 
 #[cfg(feature = "gltf")]
 mod gltf;
@@ -18,6 +21,7 @@ pub use gltf::{parse_gltf, MAX_INSTANCED};
 pub use gltf_write::save_gltf;
 pub use obj::{parse_obj, parse_obj_with};
 pub use ply::parse_ply;
+pub use ply::save_ply;
 
 use super::{clean, CleanOptions, CleanReport, Mesh, RawMesh};
 use crate::error::{Error, Result};
@@ -65,7 +69,8 @@ pub const MAX_FILE_BYTES: u64 = 4 << 30;
 pub enum Format {
     /// Wavefront OBJ (geometry only; materials are ignored).
     Obj,
-    /// Stanford PLY, ascii or binary.
+    /// Stanford PLY, ascii or binary, with vertex normals, texture
+    /// coordinates and colours.
     Ply,
     /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
     #[cfg(feature = "gltf")]

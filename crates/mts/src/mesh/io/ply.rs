@@ -1,4 +1,5 @@
-//! Stanford PLY reader: `ascii`, `binary_little_endian`, `binary_big_endian`.
+//! Stanford PLY reader (`ascii`, `binary_little_endian`,
+//! `binary_big_endian`) and writer (binary little endian).
 //!
 //! Hand-written rather than built on `ply-rs-bw` so that every error names
 //! the file, line or byte offset, element and index, and so that no
@@ -6,14 +7,33 @@
 //! the remaining bytes can hold, and lists are read item by item.
 //!
 //! Read: `vertex` (`x`, `y`, `z` of any numeric type), `face` (list
-//! `vertex_indices` or `vertex_index`, any polygon size, fan-triangulated),
-//! `tristrips` (list `vertex_indices`, `-1` restarts, odd triangles flipped).
-//! Every other element and property is skipped according to its declared
-//! type, list properties included.
+//! `vertex_indices` or `vertex_index`, any polygon size, triangulated by
+//! [`super::triangulate_polygon`]), `tristrips` (list `vertex_indices`,
+//! `-1` restarts, odd triangles flipped). Vertex property streams, each
+//! component of any scalar type:
+//!
+//! - normals `nx ny nz`;
+//! - texture coordinates `texture_u texture_v`, `u v`, `s t` or
+//!   `texture_s texture_t` (the first of these pairs declared whole), `v`
+//!   up as in OBJ;
+//! - colours `red green blue [alpha]`, `r g b [a]` or `diffuse_red
+//!   diffuse_green diffuse_blue [diffuse_alpha]`: integer types divided by
+//!   their largest value (`uchar` by 255, `ushort` by 65535), floats taken
+//!   as they are; no alpha is 1.
+//!
+//! A stream is read only when every component it needs is declared: a lone
+//! `nx`, or `u` without `v`, is skipped like any unknown property. A
+//! component declared as a list is an error. The first header line
+//! `comment TextureFile name.png` (MeshLab writes it) names the texture the
+//! coordinates sample, resolved against the PLY file's folder; it is kept
+//! only with texture coordinates. Per-face properties (colours, normals,
+//! MeshLab's per-corner `texcoord` lists) are ignored. Every other element
+//! and property is skipped according to its declared type, list properties
+//! included.
 
 use crate::error::{Error, Place, Result};
-use crate::mesh::RawMesh;
-use glam::Vec3;
+use crate::mesh::{Mesh, RawMesh, Texture};
+use glam::{Vec2, Vec3, Vec4};
 use std::path::Path;
 
 /// Longest header accepted, in bytes; real headers are a few hundred.
@@ -65,6 +85,20 @@ impl Scalar {
     fn is_integer(self) -> bool {
         !matches!(self, Scalar::F32 | Scalar::F64)
     }
+
+    /// What a colour channel of this type is multiplied by to bring it to
+    /// 0..=1: the reciprocal of the type's largest value, 1 for floats.
+    fn color_scale(self) -> f64 {
+        1.0 / match self {
+            Scalar::I8 => f64::from(i8::MAX),
+            Scalar::U8 => f64::from(u8::MAX),
+            Scalar::I16 => f64::from(i16::MAX),
+            Scalar::U16 => f64::from(u16::MAX),
+            Scalar::I32 => f64::from(i32::MAX),
+            Scalar::U32 => f64::from(u32::MAX),
+            Scalar::F32 | Scalar::F64 => 1.0,
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -77,6 +111,8 @@ enum Kind {
 struct Property {
     name: String,
     kind: Kind,
+    /// Its header line.
+    line: u64,
 }
 
 #[derive(Debug, Clone)]
@@ -107,16 +143,23 @@ struct Header {
     data_start: usize,
     /// Line number of the first data line (ascii).
     data_line: u64,
+    /// The first `comment TextureFile` name, as written.
+    texture: Option<String>,
 }
 
-/// Parses PLY bytes into a raw mesh.
+/// Parses PLY bytes into a raw mesh, with the vertex property streams the
+/// header declares (see the module docs); `path` names the file in errors
+/// and is the folder a `TextureFile` is resolved against.
 ///
 /// # Errors
 /// [`Error::UnknownFormat`] without the `ply` magic or with an unknown
 /// `format`; [`Error::Parse`] with line (ascii and header) or byte offset
-/// (binary), element and index for a malformed header, truncated data,
-/// non-numeric tokens, NaN or infinite coordinates, indices out of range,
-/// and header counts larger than the data.
+/// (binary), element and index for a malformed header (a property stream
+/// component or an index declared with the wrong kind of type: the
+/// property's line), truncated data, non-numeric tokens, NaN or infinite
+/// coordinates, normals, texture coordinates or colours (the line or byte
+/// of the value), indices out of range, and header counts larger than the
+/// data.
 ///
 /// Cost: O(file size); memory O(vertices + triangles) actually present.
 pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<RawMesh> {
@@ -147,6 +190,10 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<RawMesh> {
     let mut raw = RawMesh::default();
     for element in &header.elements {
         read_element(&mut reader, element, vertex_count, &mut raw, &file)?;
+    }
+    if let (Some(name), Some(_)) = (&header.texture, &raw.properties.uvs) {
+        let folder = path.parent().unwrap_or(Path::new(""));
+        raw.properties.texture = Some(Texture::File(folder.join(name)));
     }
     // What follows the last element is not part of the mesh: a wrong count
     // in the header, or two files run together. Whitespace ends ASCII data.
@@ -214,6 +261,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     }
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
+    let mut texture = None;
     let mut pos = 0usize;
     let mut line_no = 0u64;
     loop {
@@ -230,6 +278,13 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
             ["ply"] if line_no == 1 => {}
+            ["comment", tag, ..] if tag.eq_ignore_ascii_case("TextureFile") => {
+                // The rest of the line, inner spaces kept.
+                let name = line.trim_start()["comment".len()..].trim_start()[tag.len()..].trim();
+                if texture.is_none() && !name.is_empty() {
+                    texture = Some(name.to_owned());
+                }
+            }
             [] | ["comment", ..] | ["obj_info", ..] => {}
             ["format", f, _version] => {
                 encoding = Some(match *f {
@@ -250,6 +305,9 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                         format!("element `{name}` has a bad count `{count}`"),
                     )
                 })?;
+                if *name == "vertex" && elements.iter().any(|e| e.name == "vertex") {
+                    return Err(bad(line_no, "a second `vertex` element".into()));
+                }
                 elements.push(Element {
                     name: (*name).to_owned(),
                     count,
@@ -276,6 +334,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 element.properties.push(Property {
                     name: (*name).to_owned(),
                     kind: Kind::List { count, item },
+                    line: line_no,
                 });
             }
             ["property", ty, name] => {
@@ -288,6 +347,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 element.properties.push(Property {
                     name: (*name).to_owned(),
                     kind: Kind::Scalar(ty),
+                    line: line_no,
                 });
             }
             ["end_header"] => break,
@@ -305,6 +365,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
         elements,
         data_start: pos,
         data_line: line_no + 1,
+        texture,
     })
 }
 
@@ -316,17 +377,20 @@ enum ReadError {
     Malformed(String),
 }
 
+#[derive(Clone)]
 enum Reader<'a> {
     Ascii(AsciiReader<'a>),
     Binary(BinaryReader<'a>),
 }
 
+#[derive(Clone)]
 struct AsciiReader<'a> {
     bytes: &'a [u8],
     pos: usize,
     line: u64,
 }
 
+#[derive(Clone)]
 struct BinaryReader<'a> {
     bytes: &'a [u8],
     pos: usize,
@@ -335,6 +399,9 @@ struct BinaryReader<'a> {
 
 impl Reader<'_> {
     /// Reads one value of type `ty` as f64 (exact for every PLY integer type).
+    /// Inlined with the binary read into the element loops: a call per
+    /// value was 8% of the instructions of a binary parse (lucy.ply).
+    #[inline(always)]
     fn read(&mut self, ty: Scalar) -> std::result::Result<f64, ReadError> {
         match self {
             Reader::Ascii(r) => r.read(ty),
@@ -371,13 +438,18 @@ impl Reader<'_> {
 }
 
 impl AsciiReader<'_> {
-    fn read(&mut self, ty: Scalar) -> std::result::Result<f64, ReadError> {
+    /// Moves to the next token, counting lines.
+    fn skip_whitespace(&mut self) {
         while self.pos < self.bytes.len() && self.bytes[self.pos].is_ascii_whitespace() {
             if self.bytes[self.pos] == b'\n' {
                 self.line += 1;
             }
             self.pos += 1;
         }
+    }
+
+    fn read(&mut self, ty: Scalar) -> std::result::Result<f64, ReadError> {
+        self.skip_whitespace();
         let start = self.pos;
         while self.pos < self.bytes.len() && !self.bytes[self.pos].is_ascii_whitespace() {
             self.pos += 1;
@@ -385,17 +457,48 @@ impl AsciiReader<'_> {
         if start == self.pos {
             return Err(ReadError::Eof);
         }
-        let token = std::str::from_utf8(&self.bytes[start..self.pos]).unwrap_or("?");
+        let token = &self.bytes[start..self.pos];
+        let malformed = |what: &str| {
+            let token = String::from_utf8_lossy(token);
+            ReadError::Malformed(format!("`{token}` is not {what}"))
+        };
         if ty.is_integer() {
-            token
-                .parse::<i64>()
+            parse_integer(token)
                 .map(|v| v as f64)
-                .map_err(|_| ReadError::Malformed(format!("`{token}` is not an integer")))
+                .ok_or_else(|| malformed("an integer"))
         } else {
-            token
-                .parse::<f64>()
-                .map_err(|_| ReadError::Malformed(format!("`{token}` is not a number")))
+            std::str::from_utf8(token)
+                .ok()
+                .and_then(|t| t.parse::<f64>().ok())
+                .ok_or_else(|| malformed("a number"))
         }
+    }
+}
+
+/// A decimal integer with an optional sign, read as `i64::from_str` reads
+/// it but from bytes: most tokens of an ascii PLY are indices, and checking
+/// each for UTF-8 first cost a fifth of the parse.
+fn parse_integer(token: &[u8]) -> Option<i64> {
+    let (negative, digits) = match token {
+        [b'-', rest @ ..] => (true, rest),
+        [b'+', rest @ ..] => (false, rest),
+        _ => (false, token),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    // Accumulated negative, so that i64::MIN fits.
+    let mut v: i64 = 0;
+    for &d in digits {
+        if !d.is_ascii_digit() {
+            return None;
+        }
+        v = v.checked_mul(10)?.checked_sub(i64::from(d - b'0'))?;
+    }
+    if negative {
+        Some(v)
+    } else {
+        v.checked_neg()
     }
 }
 
@@ -412,6 +515,7 @@ impl BinaryReader<'_> {
         Ok(bytes)
     }
 
+    #[inline(always)]
     fn read(&mut self, ty: Scalar) -> std::result::Result<f64, ReadError> {
         macro_rules! num {
             ($t:ty, $n:literal) => {{
@@ -440,10 +544,127 @@ impl BinaryReader<'_> {
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Role {
     Skip,
-    Coord(usize),
+    /// A vertex value, stored in this slot of [`Slots`].
+    Value(usize),
     Indices,
 }
 
+/// One vertex's values: position, normal, texture coordinate, colour.
+type Slots = [f64; SLOT_COUNT];
+const SLOT_COUNT: usize = 12;
+const POSITION: usize = 0;
+const NORMAL: usize = 3;
+const UV: usize = 6;
+const COLOR: usize = 8;
+
+/// Component names of each vertex stream, families in the order tried.
+const POSITION_NAMES: &[&[&str]] = &[&["x", "y", "z"]];
+const NORMAL_NAMES: &[&[&str]] = &[&["nx", "ny", "nz"]];
+const UV_NAMES: &[&[&str]] = &[
+    &["texture_u", "texture_v"],
+    &["u", "v"],
+    &["s", "t"],
+    &["texture_s", "texture_t"],
+];
+/// Alpha, the fourth, may be absent.
+const COLOR_NAMES: &[&[&str]] = &[
+    &["red", "green", "blue", "alpha"],
+    &["r", "g", "b", "a"],
+    &[
+        "diffuse_red",
+        "diffuse_green",
+        "diffuse_blue",
+        "diffuse_alpha",
+    ],
+];
+
+/// Where each property of a `vertex` element goes and which streams it
+/// fills.
+struct VertexLayout {
+    roles: Vec<Role>,
+    normals: bool,
+    uvs: bool,
+    colors: bool,
+    /// The property each slot is read from (for error places), or
+    /// `usize::MAX`.
+    source: [usize; SLOT_COUNT],
+    /// Slot values before a vertex is read: 1 for alpha, which may be
+    /// absent.
+    initial: Slots,
+    /// What each colour channel is multiplied by ([`Scalar::color_scale`]).
+    color_scale: [f64; 4],
+}
+
+impl VertexLayout {
+    /// The layout of `element`, or the header error as (line, message).
+    fn new(element: &Element) -> std::result::Result<VertexLayout, (u64, String)> {
+        let known = [POSITION_NAMES, NORMAL_NAMES, UV_NAMES, COLOR_NAMES];
+        if let Some(p) = element.properties.iter().find(|p| {
+            matches!(p.kind, Kind::List { .. })
+                && known
+                    .iter()
+                    .flat_map(|f| f.iter())
+                    .any(|f| f.contains(&&*p.name))
+        }) {
+            return Err((
+                p.line,
+                format!(
+                    "vertex property `{}` is a list; a position, normal, texture coordinate \
+                     or colour component is one scalar",
+                    p.name
+                ),
+            ));
+        }
+        // The last scalar of that name (a repeated name: the last value wins).
+        let find = |name: &str| element.properties.iter().rposition(|p| p.name == name);
+        let mut layout = VertexLayout {
+            roles: vec![Role::Skip; element.properties.len()],
+            normals: false,
+            uvs: false,
+            colors: false,
+            source: [usize::MAX; SLOT_COUNT],
+            initial: [0.0; SLOT_COUNT],
+            color_scale: [1.0; 4],
+        };
+        layout.initial[COLOR + 3] = 1.0;
+        let mut place = |families: &[&[&str]], required: usize, first_slot: usize| {
+            let family = families
+                .iter()
+                .find(|f| f[..required].iter().all(|n| find(n).is_some()))?;
+            for (k, name) in family.iter().enumerate() {
+                if let Some(p) = find(name) {
+                    layout.roles[p] = Role::Value(first_slot + k);
+                    layout.source[first_slot + k] = p;
+                }
+            }
+            Some(())
+        };
+        if place(POSITION_NAMES, 3, POSITION).is_none() {
+            let missing = ["x", "y", "z"].into_iter().find(|n| find(n).is_none());
+            return Err((
+                element.line,
+                format!(
+                    "`vertex` element has no scalar `{}` property",
+                    missing.unwrap_or("x")
+                ),
+            ));
+        }
+        layout.normals = place(NORMAL_NAMES, 3, NORMAL).is_some();
+        layout.uvs = place(UV_NAMES, 2, UV).is_some();
+        layout.colors = place(COLOR_NAMES, 3, COLOR).is_some();
+        for c in 0..4 {
+            if let Some(p) = element.properties.get(layout.source[COLOR + c]) {
+                if let Kind::Scalar(ty) = p.kind {
+                    layout.color_scale[c] = ty.color_scale();
+                }
+            }
+        }
+        Ok(layout)
+    }
+}
+
+/// Reads every instance of `element` into `raw`: vertices with their
+/// streams, faces and strips as triangles, anything else skipped.
 fn read_element(
     reader: &mut Reader<'_>,
     element: &Element,
@@ -455,32 +676,15 @@ fn read_element(
         // Nothing to read, whatever the count says.
         return Ok(());
     }
-    let header_err = |message: String| Error::Parse {
+    let header_err = |line: u64, message: String| Error::Parse {
         file: file.to_owned(),
-        place: Place::line(element.line),
+        place: Place::line(line),
         message,
     };
-    let roles: Vec<Role> = match element.name.as_str() {
+    match element.name.as_str() {
         "vertex" => {
-            let roles: Vec<Role> = element
-                .properties
-                .iter()
-                .map(|p| match (p.name.as_str(), &p.kind) {
-                    ("x", Kind::Scalar(_)) => Role::Coord(0),
-                    ("y", Kind::Scalar(_)) => Role::Coord(1),
-                    ("z", Kind::Scalar(_)) => Role::Coord(2),
-                    _ => Role::Skip,
-                })
-                .collect();
-            for axis in 0..3 {
-                if !roles.contains(&Role::Coord(axis)) {
-                    return Err(header_err(format!(
-                        "`vertex` element has no scalar `{}` property",
-                        ["x", "y", "z"][axis]
-                    )));
-                }
-            }
-            roles
+            let layout = VertexLayout::new(element).map_err(|(line, m)| header_err(line, m))?;
+            read_vertices(reader, element, &layout, raw, file)
         }
         "face" | "tristrips" => {
             let is_index_list = |p: &Property| {
@@ -488,114 +692,253 @@ fn read_element(
                     && (p.name == "vertex_indices" || p.name == "vertex_index")
             };
             let Some(which) = element.properties.iter().position(is_index_list) else {
-                return Err(header_err(format!(
-                    "`{}` element has no list property `vertex_indices`",
-                    element.name
-                )));
-            };
-            if let Kind::List { item, .. } = element.properties[which].kind {
-                if !item.is_integer() {
-                    return Err(header_err(format!(
-                        "`{}` indices have a non-integer type",
+                return Err(header_err(
+                    element.line,
+                    format!(
+                        "`{}` element has no list property `vertex_indices`",
                         element.name
-                    )));
-                }
-            }
-            (0..element.properties.len())
-                .map(|i| {
-                    if i == which {
-                        Role::Indices
-                    } else {
-                        Role::Skip
-                    }
-                })
-                .collect()
-        }
-        _ => vec![Role::Skip; element.properties.len()],
-    };
-    let is_vertex = element.name == "vertex";
-    let is_strip = element.name == "tristrips";
-    if is_vertex {
-        raw.positions.reserve(reader.capacity_for(element));
-    } else if element.name == "face" {
-        raw.triangles.reserve(reader.capacity_for(element));
-    }
-
-    let mut list: Vec<i64> = Vec::new();
-    let mut run: Vec<u32> = Vec::new();
-    for index in 0..element.count {
-        let mut coords = [0.0f64; 3];
-        for (property, &role) in element.properties.iter().zip(&roles) {
-            let fail = |reader: &Reader<'_>, e: ReadError| {
-                let message = match e {
-                    ReadError::Eof => format!(
-                        "data ends inside `{}` {index} of {} declared (property `{}`): file truncated or header count too large",
-                        element.name, element.count, property.name
                     ),
-                    ReadError::Malformed(m) => format!("property `{}`: {m}", property.name),
-                };
-                Error::Parse {
-                    file: file.to_owned(),
-                    place: reader.place(&element.name, index),
-                    message,
-                }
+                ));
             };
-            match property.kind {
-                Kind::Scalar(ty) => {
-                    let v = reader.read(ty).map_err(|e| fail(reader, e))?;
-                    if let Role::Coord(axis) = role {
-                        coords[axis] = v;
-                    }
-                }
-                Kind::List { count, item } => {
-                    let n = reader.read(count).map_err(|e| fail(reader, e))?;
-                    if n < 0.0 {
-                        return Err(fail(
-                            reader,
-                            ReadError::Malformed(format!("negative list length {n}")),
-                        ));
-                    }
-                    list.clear();
-                    for _ in 0..n as u64 {
-                        let v = reader.read(item).map_err(|e| fail(reader, e))?;
-                        if role == Role::Indices {
-                            list.push(v as i64);
-                        }
-                    }
+            let property = &element.properties[which];
+            if let Kind::List { item, .. } = property.kind {
+                if !item.is_integer() {
+                    return Err(header_err(
+                        property.line,
+                        format!("`{}` indices have a non-integer type", element.name),
+                    ));
                 }
             }
+            let mut roles = vec![Role::Skip; element.properties.len()];
+            roles[which] = Role::Indices;
+            read_faces(reader, element, &roles, vertex_count, raw, file)
         }
-        if is_vertex {
-            let p = Vec3::new(coords[0] as f32, coords[1] as f32, coords[2] as f32);
-            if !p.is_finite() {
-                return Err(Error::Parse {
-                    file: file.to_owned(),
-                    place: reader.place("vertex", index),
-                    message: format!(
-                        "coordinate is NaN or infinite (or beyond f32 range): {coords:?}"
-                    ),
-                });
+        _ => {
+            let roles = vec![Role::Skip; element.properties.len()];
+            let (mut values, mut list) = ([0.0; SLOT_COUNT], Vec::new());
+            for index in 0..element.count {
+                read_instance(reader, element, &roles, index, &mut values, &mut list, file)?;
             }
-            raw.positions.push(p);
-        } else if roles.contains(&Role::Indices) {
-            let out_of_range = list
-                .iter()
-                .find(|&&i| !((0..vertex_count as i64).contains(&i) || (is_strip && i == -1)));
-            if let Some(&i) = out_of_range {
-                return Err(Error::Parse {
-                    file: file.to_owned(),
-                    place: reader.place(&element.name, index),
-                    message: format!("vertex index {i} out of range (the header declares {vertex_count} vertices)"),
-                });
+            Ok(())
+        }
+    }
+}
+
+/// Reads one instance of `element`, number `index`: scalars with a
+/// [`Role::Value`] into their slot of `values`, the items of the
+/// [`Role::Indices`] list into `list`, the rest skipped.
+#[inline(always)]
+fn read_instance(
+    reader: &mut Reader<'_>,
+    element: &Element,
+    roles: &[Role],
+    index: u64,
+    values: &mut Slots,
+    list: &mut Vec<i64>,
+    file: &Path,
+) -> Result<()> {
+    for (property, &role) in element.properties.iter().zip(roles) {
+        let fail = |reader: &Reader<'_>, e: ReadError| {
+            let message = match e {
+                ReadError::Eof => format!(
+                    "data ends inside `{}` {index} of {} declared (property `{}`): file \
+                     truncated or header count too large",
+                    element.name, element.count, property.name
+                ),
+                ReadError::Malformed(m) => format!("property `{}`: {m}", property.name),
+            };
+            Error::Parse {
+                file: file.to_owned(),
+                place: reader.place(&element.name, index),
+                message,
             }
-            if is_strip {
-                push_strip(&list, &mut run, raw);
-            } else {
-                push_polygon(&list, &mut run, raw);
+        };
+        match property.kind {
+            Kind::Scalar(ty) => {
+                let v = reader.read(ty).map_err(|e| fail(reader, e))?;
+                if let Role::Value(slot) = role {
+                    values[slot] = v;
+                }
+            }
+            Kind::List { count, item } => {
+                let n = reader.read(count).map_err(|e| fail(reader, e))?;
+                if n < 0.0 {
+                    return Err(fail(
+                        reader,
+                        ReadError::Malformed(format!("negative list length {n}")),
+                    ));
+                }
+                if role == Role::Indices {
+                    list.clear();
+                }
+                for _ in 0..n as u64 {
+                    let v = reader.read(item).map_err(|e| fail(reader, e))?;
+                    if role == Role::Indices {
+                        list.push(v as i64);
+                    }
+                }
             }
         }
     }
     Ok(())
+}
+
+/// Reads the `vertex` element: positions and the streams of `layout`.
+fn read_vertices(
+    reader: &mut Reader<'_>,
+    element: &Element,
+    layout: &VertexLayout,
+    raw: &mut RawMesh,
+    file: &Path,
+) -> Result<()> {
+    let capacity = reader.capacity_for(element);
+    raw.positions.reserve(capacity);
+    let streams = &mut raw.properties;
+    if layout.normals {
+        streams.normals = Some(Vec::with_capacity(capacity));
+    }
+    if layout.uvs {
+        streams.uvs = Some(Vec::with_capacity(capacity));
+    }
+    if layout.colors {
+        streams.colors = Some(Vec::with_capacity(capacity));
+    }
+    let mut values = layout.initial;
+    let mut list = Vec::new();
+    for index in 0..element.count {
+        let start = reader.clone();
+        read_instance(
+            reader,
+            element,
+            &layout.roles,
+            index,
+            &mut values,
+            &mut list,
+            file,
+        )?;
+        push_vertex(&values, layout, raw).map_err(|slot| {
+            let property = layout.source[slot];
+            Error::Parse {
+                file: file.to_owned(),
+                place: property_place(start, element, index, property),
+                message: format!(
+                    "`{}` is NaN or infinite (or beyond f32 range): {}",
+                    element.properties[property].name, values[slot]
+                ),
+            }
+        })?;
+    }
+    Ok(())
+}
+
+/// Reads a `face` or `tristrips` element (its index list at the
+/// [`Role::Indices`] of `roles`) into triangles.
+fn read_faces(
+    reader: &mut Reader<'_>,
+    element: &Element,
+    roles: &[Role],
+    vertex_count: u64,
+    raw: &mut RawMesh,
+    file: &Path,
+) -> Result<()> {
+    let is_strip = element.name == "tristrips";
+    if !is_strip {
+        raw.triangles.reserve(reader.capacity_for(element));
+    }
+    let mut values = [0.0; SLOT_COUNT];
+    let mut list: Vec<i64> = Vec::new();
+    let mut run: Vec<u32> = Vec::new();
+    for index in 0..element.count {
+        read_instance(reader, element, roles, index, &mut values, &mut list, file)?;
+        let out_of_range = list
+            .iter()
+            .find(|&&i| !((0..vertex_count as i64).contains(&i) || (is_strip && i == -1)));
+        if let Some(&i) = out_of_range {
+            return Err(Error::Parse {
+                file: file.to_owned(),
+                place: reader.place(&element.name, index),
+                message: format!(
+                    "vertex index {i} out of range (the header declares {vertex_count} vertices)"
+                ),
+            });
+        }
+        if is_strip {
+            push_strip(&list, &mut run, raw);
+        } else {
+            push_polygon(&list, &mut run, raw);
+        }
+    }
+    Ok(())
+}
+
+/// Appends one vertex's position and streams, or returns the slot of its
+/// first value that is not a finite `f32`.
+#[inline]
+fn push_vertex(
+    v: &Slots,
+    layout: &VertexLayout,
+    raw: &mut RawMesh,
+) -> std::result::Result<(), usize> {
+    let first_bad = |first: usize, count: usize| {
+        (first..first + count)
+            .find(|&s| !(v[s] as f32).is_finite())
+            .unwrap_or(first)
+    };
+    let p = Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
+    if !p.is_finite() {
+        return Err(first_bad(POSITION, 3));
+    }
+    raw.positions.push(p);
+    let streams = &mut raw.properties;
+    if let (true, Some(normals)) = (layout.normals, &mut streams.normals) {
+        let n = Vec3::new(v[NORMAL] as f32, v[NORMAL + 1] as f32, v[NORMAL + 2] as f32);
+        if !n.is_finite() {
+            return Err(first_bad(NORMAL, 3));
+        }
+        normals.push(n);
+    }
+    if let (true, Some(uvs)) = (layout.uvs, &mut streams.uvs) {
+        let t = Vec2::new(v[UV] as f32, v[UV + 1] as f32);
+        if !t.is_finite() {
+            return Err(first_bad(UV, 2));
+        }
+        uvs.push(t);
+    }
+    if let (true, Some(colors)) = (layout.colors, &mut streams.colors) {
+        // Scales are at most 1: a finite value stays finite.
+        let s = layout.color_scale;
+        let c = Vec4::new(
+            (v[COLOR] * s[0]) as f32,
+            (v[COLOR + 1] * s[1]) as f32,
+            (v[COLOR + 2] * s[2]) as f32,
+            (v[COLOR + 3] * s[3]) as f32,
+        );
+        if !c.is_finite() {
+            return Err(first_bad(COLOR, 4));
+        }
+        colors.push(c);
+    }
+    Ok(())
+}
+
+/// The place of property `property` of `element` `index`, read again from
+/// `start`, the reader where that instance begins (an error path: the
+/// instance was read once already, so every value before it is there).
+fn property_place(mut start: Reader<'_>, element: &Element, index: u64, property: usize) -> Place {
+    for p in &element.properties[..property] {
+        let _ = match p.kind {
+            Kind::Scalar(ty) => start.read(ty).map(drop),
+            Kind::List { count, item } => start.read(count).map(|n| {
+                for _ in 0..n as u64 {
+                    let _ = start.read(item);
+                }
+            }),
+        };
+    }
+    if let Reader::Ascii(r) = &mut start {
+        r.skip_whitespace();
+    }
+    start.place(&element.name, index)
 }
 
 /// Triangulates one polygon ([`super::triangulate_polygon`]); fewer than
@@ -622,5 +965,145 @@ fn push_strip(list: &[i64], run: &mut Vec<u32>, raw: &mut RawMesh) {
         crate::encoding::decode_run(run, &mut raw.triangles);
         let windows = run.len().saturating_sub(2);
         raw.degenerate_in_source += windows - (raw.triangles.len() - before);
+    }
+}
+
+/// Writes `mesh` as binary little-endian PLY to `path`: `x y z`, then the
+/// streams the mesh has, `nx ny nz` and `texture_u texture_v` (the names
+/// MeshLab writes and trimesh tries first) as `float`, `red green blue
+/// alpha` as `uchar` (each channel times 255, rounded); faces as `property
+/// list uchar uint vertex_indices`. A [`Texture::File`] is named by a
+/// `comment TextureFile` line, relative to `path`'s folder when inside it,
+/// else absolute. PLY has no place for an embedded texture or for
+/// position ids, so neither is written: [`parse_ply`] reads the file back
+/// to the same mesh with colours within 1/510, and split vertices come
+/// back as one point when the reader welds ([`crate::mesh::CleanOptions`]).
+///
+/// # Errors
+/// [`Error::Invalid`] when `mesh` breaks an invariant ([`Mesh::validate`]),
+/// [`Error::InvalidArgument`] for a texture path that is not UTF-8 or
+/// holds a line break, [`Error::Io`] naming the file.
+///
+/// Cost: O(V + T), one buffered write.
+pub fn save_ply(mesh: &Mesh, path: &Path) -> Result<()> {
+    use std::fmt::Write as _;
+    use std::io::Write as _;
+    fn put(record: &mut Vec<u8>, values: &[f32]) {
+        for x in values {
+            record.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    mesh.validate()?;
+    let streams = &mesh.properties;
+    let mut header = String::from("ply\nformat binary_little_endian 1.0\ncomment written by mts\n");
+    if let Some(Texture::File(file)) = &streams.texture {
+        let _ = writeln!(header, "comment TextureFile {}", texture_name(file, path)?);
+    }
+    let _ = write!(
+        header,
+        "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n",
+        mesh.vertex_count()
+    );
+    if streams.normals.is_some() {
+        header += "property float nx\nproperty float ny\nproperty float nz\n";
+    }
+    if streams.uvs.is_some() {
+        header += "property float texture_u\nproperty float texture_v\n";
+    }
+    if streams.colors.is_some() {
+        header +=
+            "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
+    }
+    let _ = write!(
+        header,
+        "element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        mesh.triangle_count()
+    );
+
+    let io = |source| Error::Io {
+        file: path.to_owned(),
+        source,
+    };
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    w.write_all(header.as_bytes()).map_err(io)?;
+    let mut record: Vec<u8> = Vec::with_capacity(48);
+    for (v, p) in mesh.positions.iter().enumerate() {
+        record.clear();
+        put(&mut record, &p.to_array());
+        if let Some(normals) = &streams.normals {
+            put(&mut record, &normals[v].to_array());
+        }
+        if let Some(uvs) = &streams.uvs {
+            put(&mut record, &uvs[v].to_array());
+        }
+        if let Some(colors) = &streams.colors {
+            let c = colors[v].to_array();
+            record.extend(c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8));
+        }
+        w.write_all(&record).map_err(io)?;
+    }
+    for t in &mesh.triangles {
+        record.clear();
+        record.push(3);
+        for i in t {
+            record.extend_from_slice(&i.to_le_bytes());
+        }
+        w.write_all(&record).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
+
+/// How a `comment TextureFile` line names `texture` for a PLY at `ply`.
+fn texture_name(texture: &Path, ply: &Path) -> Result<String> {
+    let folder = ply.parent().unwrap_or(Path::new(""));
+    let name = match texture.strip_prefix(folder) {
+        Ok(inside) => inside.to_owned(),
+        Err(_) => std::path::absolute(texture).map_err(|e| {
+            Error::InvalidArgument(format!("texture path {}: {e}", texture.display()))
+        })?,
+    };
+    match name.to_str() {
+        Some(s) if !s.contains(['\n', '\r']) && !s.trim().is_empty() => Ok(s.to_owned()),
+        _ => Err(Error::InvalidArgument(format!(
+            "texture path {} cannot be written on a PLY header line (not UTF-8, empty, or a line break)",
+            texture.display()
+        ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_integer;
+
+    /// The same integers as `i64::from_str`, edges of the range included.
+    #[test]
+    fn integers_read_as_from_str_reads_them() {
+        for token in [
+            "",
+            "+",
+            "-",
+            "0",
+            "-0",
+            "+12",
+            "007",
+            "-45",
+            "1e3",
+            "12a",
+            " 1",
+            "--1",
+            "+-1",
+            "9223372036854775807",
+            "9223372036854775808",
+            "-9223372036854775808",
+            "-9223372036854775809",
+            "99999999999999999999",
+            "\u{663}",
+        ] {
+            assert_eq!(
+                parse_integer(token.as_bytes()),
+                token.parse::<i64>().ok(),
+                "{token:?}"
+            );
+        }
     }
 }
