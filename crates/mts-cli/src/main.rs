@@ -48,7 +48,7 @@ enum Command {
     Simplify(SimplifyArgs),
     /// Hausdorff and RMS distance of a mesh to a reference mesh.
     Distance(DistanceArgs),
-    /// Write a mesh (a file or a generated one) as OBJ, glTF (.glb/.gltf) by the extension of the output.
+    /// Write a mesh (a file or a generated one) as .obj, .ply, .glb or .gltf (by the output's extension).
     Convert(ConvertArgs),
     /// Build the MTS model (strips, contraction sequence, per-strip graphs)
     /// and write it as an .mts file.
@@ -443,7 +443,7 @@ struct SimplifyArgs {
     /// Keep at most this many triangles.
     #[arg(allow_negative_numbers = true, long)]
     triangles: Option<usize>,
-    /// Write the simplified mesh (.obj, .glb or .gltf, by extension; with --properties, its properties).
+    /// Write the simplified mesh (.obj, .ply, .glb or .gltf, by extension; with --properties, its properties).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Print JSON instead of a table.
@@ -1018,7 +1018,7 @@ struct ExtractArgs {
     source: MeshSource,
     #[command(flatten)]
     level: LevelArgs,
-    /// Write the extracted triangles (.obj, .glb or .gltf, by extension).
+    /// Write the extracted triangles (.obj, .ply, .glb or .gltf, by extension).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Timed extractions from scratch (1 to 10,000); the median is reported.
@@ -1420,7 +1420,7 @@ struct DecodeArgs {
     /// Decode only the first N bytes (the packets they hold completely).
     #[arg(allow_negative_numbers = true, long)]
     bytes: Option<usize>,
-    /// Write the decoded mesh (.obj, .glb or .gltf, by extension).
+    /// Write the decoded mesh (.obj, .ply, .glb or .gltf, by extension).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Print JSON instead of a sentence.

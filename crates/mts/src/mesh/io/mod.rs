@@ -220,7 +220,7 @@ pub fn load(path: &Path, options: LoadOptions) -> Result<(Mesh, CleanReport)> {
 }
 
 /// Writes `mesh` in the format its extension names: `.obj`
-/// ([`save_obj`]), and with the `gltf` feature `.glb` and `.gltf`
+/// ([`save_obj`]), `.ply` ([`save_ply`]), and with the `gltf` feature `.glb` and `.gltf`
 /// (`save_gltf`).
 ///
 /// # Errors
@@ -233,11 +233,12 @@ pub fn save_mesh(mesh: &Mesh, path: &Path) -> Result<()> {
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("obj") => save_obj(mesh, path),
+        Some("ply") => save_ply(mesh, path),
         #[cfg(feature = "gltf")]
         Some("glb" | "gltf") => save_gltf(mesh, path),
         _ => Err(Error::UnknownFormat {
             file: path.to_owned(),
-            message: "writes .obj, .glb and .gltf (by extension)".into(),
+            message: "writes .obj, .ply, .glb and .gltf (by extension)".into(),
         }),
     }
 }
