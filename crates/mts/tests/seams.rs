@@ -197,3 +197,31 @@ fn corrupt_version_2_files_are_errors_or_valid_models() {
         }
     }
 }
+
+#[test]
+fn generated_properties_are_valid_and_the_torus_seams_stay_closed() {
+    use mts::mesh::generate::Generated;
+    for name in ["torus:2000", "grid:2000", "icosphere:2000"] {
+        let g: Generated = name.parse().unwrap();
+        let mesh = g.build_with_properties();
+        mesh.validate().unwrap();
+        let plain = g.build();
+        assert_eq!(mesh.triangle_count(), plain.triangle_count(), "{name}");
+        let p = &mesh.properties;
+        assert!(p.colors.is_some() && p.normals.is_some(), "{name}");
+        assert_eq!(p.uvs.is_some(), !name.starts_with("icosphere"), "{name}");
+        let (borders0, seam_points0) = borders_and_seam_points(&mesh);
+        // The torus's two seam loops meet at one point.
+        assert_eq!(seam_points0 > 0, name.starts_with("torus"), "{name}");
+        let s = simplify(&mesh, &SimplifyOptions::default());
+        for share in [0.1, 0.01] {
+            let at = s.collapses.mesh_at(&mesh, s.collapses.lod_for_ratio(share));
+            at.validate().unwrap();
+            let (borders, seam_points) = borders_and_seam_points(&at);
+            assert!(
+                borders <= borders0 && seam_points <= seam_points0,
+                "{name} at {share}"
+            );
+        }
+    }
+}

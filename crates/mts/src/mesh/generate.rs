@@ -9,7 +9,7 @@
 
 use super::Mesh;
 use crate::error::{Error, Result};
-use glam::Vec3;
+use glam::{Vec2, Vec3, Vec4};
 use std::collections::HashMap;
 use std::f32::consts::TAU;
 use std::fmt;
@@ -262,6 +262,97 @@ impl Generated {
             }
         }
     }
+}
+
+impl Generated {
+    /// [`Generated::build`] with procedural properties, for measuring them
+    /// on any size: a torus gets texture coordinates `(i / major, j /
+    /// minor)` with real seams (the parameter lines where they wrap from 1
+    /// to 0 split their vertices), analytic normals and colours from its
+    /// UVs; a grid gets UVs and colours over its extent and +z normals; an
+    /// icosphere gets radial normals and colours from its positions (no
+    /// UVs: a sphere has no seamless parameterisation to give).
+    ///
+    /// Cost: O(triangles).
+    #[must_use]
+    pub fn build_with_properties(self) -> Mesh {
+        let colour = |u: f32, v: f32| Vec4::new(u, v, 1.0 - 0.5 * (u + v), 1.0);
+        match self.kind {
+            GeneratedKind::Torus => {
+                let minor = ((self.triangles.max(1) as f64 / 4.0).sqrt().round() as u32).max(3);
+                seamed_torus(2 * minor, minor)
+            }
+            GeneratedKind::Grid | GeneratedKind::Icosphere => {
+                let mut mesh = self.build();
+                let (lo, hi) = super::bounds_of(&mesh.positions).unwrap_or_default();
+                let size = (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
+                let unit: Vec<Vec3> = mesh.positions.iter().map(|&p| (p - lo) / size).collect();
+                let p = &mut mesh.properties;
+                p.colors = Some(unit.iter().map(|t| colour(t.x, t.y)).collect());
+                if self.kind == GeneratedKind::Grid {
+                    p.uvs = Some(unit.iter().map(|t| Vec2::new(t.x, t.y)).collect());
+                    p.normals = Some(vec![Vec3::Z; unit.len()]);
+                } else {
+                    let centre = 0.5 * (lo + hi);
+                    p.normals = Some(
+                        mesh.positions
+                            .iter()
+                            .map(|&q| (q - centre).normalize_or_zero())
+                            .collect(),
+                    );
+                }
+                mesh
+            }
+        }
+    }
+}
+
+/// [`torus`] with texture coordinates, normals and colours: a vertex per
+/// `(i, j)` for `i` in `0..=major` and `j` in `0..=minor`, those at
+/// `i = major` or `j = minor` sharing the point of `i = 0` or `j = 0`.
+fn seamed_torus(major: u32, minor: u32) -> Mesh {
+    let (big, small) = (1.0f32, 0.35f32);
+    let (w, h) = (major + 1, minor + 1);
+    let mut positions = Vec::with_capacity((w * h) as usize);
+    let (mut uvs, mut normals, mut colors, mut ids) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for i in 0..w {
+        let u = TAU * (i % major) as f32 / major as f32;
+        for j in 0..h {
+            let v = TAU * (j % minor) as f32 / minor as f32;
+            let r = big + small * v.cos();
+            positions.push(Vec3::new(r * u.cos(), r * u.sin(), small * v.sin()));
+            normals.push(Vec3::new(v.cos() * u.cos(), v.cos() * u.sin(), v.sin()));
+            let t = Vec2::new(i as f32 / major as f32, j as f32 / minor as f32);
+            uvs.push(t);
+            colors.push(Vec4::new(t.x, t.y, 1.0 - 0.5 * (t.x + t.y), 1.0));
+            ids.push((i % major) * minor + (j % minor));
+        }
+    }
+    let id = |i: u32, j: u32| i * h + j;
+    let mut triangles = Vec::with_capacity(2 * (major * minor) as usize);
+    for i in 0..major {
+        for j in 0..minor {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    let raw = super::RawMesh {
+        positions,
+        triangles,
+        degenerate_in_source: 0,
+        properties: super::Properties {
+            normals: Some(normals),
+            uvs: Some(uvs),
+            colors: Some(colors),
+            position_ids: ids,
+            texture: None,
+        },
+    };
+    super::clean(raw, super::CleanOptions::default(), "torus")
+        .expect("a torus has triangles")
+        .0
 }
 
 impl fmt::Display for Generated {
