@@ -3,7 +3,8 @@
 //! Built top-down by splitting the triangles at the median centroid along
 //! the longest axis of the centroids' bounds (O(T log T)); queried
 //! depth-first, nearer child first, pruning boxes farther than the best
-//! distance found so far.
+//! distance found so far. Each triangle keeps its index in the input, so a
+//! query can say which triangle it landed on ([`TriangleBvh::closest_triangle`]).
 
 use glam::{DVec3, Vec3};
 
@@ -28,24 +29,40 @@ pub struct TriangleBvh {
     nodes: Vec<Node>,
     /// Triangle corners in leaf order.
     triangles: Vec<[Vec3; 3]>,
+    /// `ids[i]` is the index in the input of `triangles[i]`; apart from
+    /// `triangles` so that the queries' inner loop reads corners only.
+    ids: Vec<u32>,
 }
 
 impl TriangleBvh {
     /// Builds the hierarchy over `triangles` (corner positions; degenerate
     /// triangles are fine). O(T log T).
+    ///
+    /// # Panics
+    /// If there are more than `u32::MAX` triangles.
     #[must_use]
-    pub fn new(mut triangles: Vec<[Vec3; 3]>) -> TriangleBvh {
-        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
-        if !triangles.is_empty() {
+    pub fn new(triangles: Vec<[Vec3; 3]>) -> TriangleBvh {
+        assert!(
+            u32::try_from(triangles.len()).is_ok(),
+            "TriangleBvh holds at most u32::MAX triangles"
+        );
+        let mut items: Vec<([Vec3; 3], u32)> = triangles.into_iter().zip(0..).collect();
+        let mut nodes = Vec::with_capacity(2 * items.len() / LEAF_SIZE + 1);
+        if !items.is_empty() {
             nodes.push(Node {
                 min: Vec3::ZERO,
                 max: Vec3::ZERO,
                 start: 0,
                 count: 0,
             });
-            build(&mut nodes, &mut triangles, 0, 0);
+            build(&mut nodes, &mut items, 0, 0);
         }
-        TriangleBvh { nodes, triangles }
+        let (triangles, ids) = items.into_iter().unzip();
+        TriangleBvh {
+            nodes,
+            triangles,
+            ids,
+        }
     }
 
     /// Number of triangles.
@@ -58,25 +75,42 @@ impl TriangleBvh {
     /// `None` when there are no triangles. Allocation-free.
     #[must_use]
     pub fn closest(&self, p: Vec3) -> Option<(Vec3, f32)> {
+        self.nearest(p).map(|(_, q, d)| (q, d))
+    }
+
+    /// [`TriangleBvh::closest`] and the triangle the point lies on, as its
+    /// index in the triangles given to [`TriangleBvh::new`]: `(triangle,
+    /// point, squared distance)`. Among triangles equally close, the one
+    /// whose point `closest` returns. Allocation-free.
+    #[must_use]
+    pub fn closest_triangle(&self, p: Vec3) -> Option<(u32, Vec3, f32)> {
+        self.nearest(p).map(|(i, q, d)| (self.ids[i], q, d))
+    }
+
+    /// The closest point's triangle in leaf order, the point and its
+    /// squared distance. Inlined into both queries, so `closest` drops the
+    /// index at no cost.
+    #[inline(always)]
+    fn nearest(&self, p: Vec3) -> Option<(usize, Vec3, f32)> {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut best = (Vec3::ZERO, f32::INFINITY);
+        let mut best = (0, Vec3::ZERO, f32::INFINITY);
         let mut stack = [0u32; 64];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let node = self.nodes[stack[top] as usize];
-            if box_distance2(&node, p) >= best.1 {
+            if box_distance2(&node, p) >= best.2 {
                 continue;
             }
             if node.count > 0 {
                 let range = node.start as usize..(node.start + node.count) as usize;
-                for t in &self.triangles[range] {
+                for (i, t) in self.triangles[range.clone()].iter().enumerate() {
                     let q = closest_on_triangle(p, t[0], t[1], t[2]);
                     let d = q.distance_squared(p);
-                    if d < best.1 {
-                        best = (q, d);
+                    if d < best.2 {
+                        best = (range.start + i, q, d);
                     }
                 }
             } else {
@@ -94,10 +128,10 @@ impl TriangleBvh {
     }
 }
 
-fn build(nodes: &mut Vec<Node>, triangles: &mut [[Vec3; 3]], node: usize, offset: usize) {
+fn build(nodes: &mut Vec<Node>, triangles: &mut [([Vec3; 3], u32)], node: usize, offset: usize) {
     let (mut min, mut max) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     let (mut cmin, mut cmax) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    for t in triangles.iter() {
+    for (t, _) in triangles.iter() {
         for &p in t {
             min = min.min(p);
             max = max.max(p);
@@ -122,7 +156,9 @@ fn build(nodes: &mut Vec<Node>, triangles: &mut [[Vec3; 3]], node: usize, offset
         2
     };
     let mid = triangles.len() / 2;
-    triangles.select_nth_unstable_by(mid, |a, b| centroid(a)[axis].total_cmp(&centroid(b)[axis]));
+    triangles.select_nth_unstable_by(mid, |a, b| {
+        centroid(&a.0)[axis].total_cmp(&centroid(&b.0)[axis])
+    });
     let left = nodes.len();
     let empty = Node {
         min: Vec3::ZERO,
@@ -162,59 +198,87 @@ pub fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 }
 
 pub(crate) fn closest_on_triangle_f64(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    closest_on_triangle_weights_f64(p, a, b, c).0
+}
+
+/// [`closest_on_triangle`] in `f64` with the point's barycentric weights
+/// `[wa, wb, wc]` (summing to 1 up to rounding): a weight is exactly 0 when
+/// the point lies on the opposite edge's or a corner's region, so a caller
+/// can tell a point on an edge or corner from one inside. The point is the
+/// one [`closest_on_triangle`] returns, bit for bit. Allocation-free.
+#[must_use]
+#[inline]
+pub(crate) fn closest_on_triangle_weights_f64(
+    p: DVec3,
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+) -> (DVec3, [f64; 3]) {
     let ab = b - a;
     let ac = c - a;
     let ap = p - a;
     let d1 = ab.dot(ap);
     let d2 = ac.dot(ap);
     if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
+        return (a, [1.0, 0.0, 0.0]);
     }
     let bp = p - b;
     let d3 = ab.dot(bp);
     let d4 = ac.dot(bp);
     if d3 >= 0.0 && d4 <= d3 {
-        return b;
+        return (b, [0.0, 1.0, 0.0]);
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
+        let t = d1 / (d1 - d3);
+        return (a + ab * t, [1.0 - t, t, 0.0]);
     }
     let cp = p - c;
     let d5 = ab.dot(cp);
     let d6 = ac.dot(cp);
     if d6 >= 0.0 && d5 <= d6 {
-        return c;
+        return (c, [0.0, 0.0, 1.0]);
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
+        let t = d2 / (d2 - d6);
+        return (a + ac * t, [1.0 - t, 0.0, t]);
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + (c - b) * t, [0.0, 1.0 - t, t]);
     }
     let sum = va + vb + vc;
     if sum <= 0.0 || !sum.is_finite() {
         // Degenerate triangle: the closest of its three edges.
-        return [(a, b), (b, c), (c, a)]
-            .into_iter()
-            .map(|(s, e)| closest_on_segment(p, s, e))
-            .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
-            .unwrap_or(a);
+        let corners = [a, b, c];
+        return (0..3)
+            .map(|k| {
+                let (q, t) = closest_on_segment(p, corners[k], corners[(k + 1) % 3]);
+                let mut w = [0.0; 3];
+                w[k] = 1.0 - t;
+                w[(k + 1) % 3] = t;
+                (q, w)
+            })
+            .min_by(|x, y| x.0.distance_squared(p).total_cmp(&y.0.distance_squared(p)))
+            .unwrap_or((a, [1.0, 0.0, 0.0]));
     }
     let v = vb / sum;
     let w = vc / sum;
-    a + ab * v + ac * w
+    (a + ab * v + ac * w, [va / sum, v, w])
 }
 
-fn closest_on_segment(p: DVec3, s: DVec3, e: DVec3) -> DVec3 {
+/// The point of segment `se` closest to `p` and its parameter along it
+/// (0 at `s`, 1 at `e`).
+fn closest_on_segment(p: DVec3, s: DVec3, e: DVec3) -> (DVec3, f64) {
     let d = e - s;
     let len2 = d.length_squared();
     if len2 <= 0.0 {
-        return s;
+        return (s, 0.0);
     }
-    s + d * ((p - s).dot(d) / len2).clamp(0.0, 1.0)
+    let t = ((p - s).dot(d) / len2).clamp(0.0, 1.0);
+    (s + d * t, t)
 }
 
 #[cfg(test)]
@@ -238,6 +302,35 @@ mod tests {
         // Degenerate (collinear) triangle.
         let q = closest_on_triangle(Vec3::new(0.5, 1.0, 0.0), a, b, Vec3::X * 2.0);
         assert!((q - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn weights_rebuild_the_point_and_zero_on_edges_and_corners() {
+        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
+        let cases = [
+            (DVec3::new(0.2, 0.3, 3.0), [0.5, 0.2, 0.3]),
+            (DVec3::new(-1.0, -1.0, 0.0), [1.0, 0.0, 0.0]),
+            (DVec3::new(2.0, -0.5, 1.0), [0.0, 1.0, 0.0]),
+            (DVec3::new(-0.1, 5.0, 0.0), [0.0, 0.0, 1.0]),
+            (DVec3::new(0.25, -2.0, 0.0), [0.75, 0.25, 0.0]),
+            (DVec3::new(-2.0, 0.5, 0.0), [0.5, 0.0, 0.5]),
+            (DVec3::new(1.0, 0.5, 0.0), [0.0, 0.75, 0.25]),
+        ];
+        for (p, want) in cases {
+            let (q, w) = closest_on_triangle_weights_f64(p, a, b, c);
+            assert_eq!(q, closest_on_triangle_f64(p, a, b, c));
+            assert!((a * w[0] + b * w[1] + c * w[2] - q).length() < 1e-12, "{p}");
+            for k in 0..3 {
+                // Zeros exact, the rest to rounding.
+                assert!(
+                    (w[k] - want[k]).abs() < 1e-12 && (want[k] != 0.0 || w[k] == 0.0),
+                    "{p}: {w:?}, want {want:?}"
+                );
+            }
+        }
+        // Degenerate: the closest point of the collinear triangle's edges.
+        let (q, w) = closest_on_triangle_weights_f64(DVec3::new(0.5, 1.0, 0.0), a, b, b * 2.0);
+        assert_eq!((q, w), (DVec3::new(0.5, 0.0, 0.0), [0.5, 0.5, 0.0]));
     }
 
     #[test]
@@ -266,9 +359,17 @@ mod tests {
                 .iter()
                 .map(|t| closest_on_triangle(p, t[0], t[1], t[2]).distance_squared(p))
                 .fold(f32::INFINITY, f32::min);
-            let (_, d) = bvh.closest(p).unwrap();
+            let (q, d) = bvh.closest(p).unwrap();
             assert_eq!(d, brute);
+            // The triangle named is the input triangle the point is on.
+            let (i, qi, di) = bvh.closest_triangle(p).unwrap();
+            assert_eq!((qi, di), (q, d));
+            let t = triangles[i as usize];
+            assert_eq!(closest_on_triangle(p, t[0], t[1], t[2]), q);
         }
         assert!(TriangleBvh::new(Vec::new()).closest(Vec3::ZERO).is_none());
+        assert!(TriangleBvh::new(Vec::new())
+            .closest_triangle(Vec3::ZERO)
+            .is_none());
     }
 }

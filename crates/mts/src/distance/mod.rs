@@ -7,10 +7,14 @@
 //! Hausdorff distance is the largest sampled distance in either direction;
 //! the RMS pools the squared distances of both directions. Both are
 //! reported relative to the reference surface's bounding-box diagonal.
+//! [`property_error`] compares normals, texture coordinates and colours
+//! at the same samples and their closest points.
 
 pub mod bvh;
+pub mod properties;
 
 pub use bvh::TriangleBvh;
+pub use properties::{property_error, PropertyError, Stat};
 
 use glam::Vec3;
 
@@ -165,13 +169,29 @@ fn one_side(from: Surface<'_>, to: Surface<'_>, samples: usize, seed: u64) -> Si
 /// its expected share, the fraction decided by the seeded generator).
 #[must_use]
 pub fn sample(s: Surface<'_>, count: usize, seed: u64) -> Vec<Vec3> {
+    let mut out = Vec::with_capacity(count + s.positions.len());
+    sample_each(s, count, seed, |p, _, _| out.push(p));
+    out
+}
+
+/// The points of [`sample`], in its order, each passed to `emit` with the
+/// triangle it lies on (an index into `s.triangles`) and its barycentric
+/// weights there: a vertex is reported on the first triangle that uses
+/// it, with weight 1 at that corner.
+pub(super) fn sample_each(
+    s: Surface<'_>,
+    count: usize,
+    seed: u64,
+    mut emit: impl FnMut(Vec3, u32, [f32; 3]),
+) {
     let mut rng = SplitMix(seed);
     let mut seen = vec![false; s.positions.len()];
-    let mut out = Vec::with_capacity(count + s.positions.len());
-    for t in s.triangles {
-        for &v in t {
+    for (i, t) in s.triangles.iter().enumerate() {
+        for (k, &v) in t.iter().enumerate() {
             if !std::mem::replace(&mut seen[v as usize], true) {
-                out.push(s.positions[v as usize]);
+                let mut weights = [0.0; 3];
+                weights[k] = 1.0;
+                emit(s.positions[v as usize], i as u32, weights);
             }
         }
     }
@@ -181,9 +201,9 @@ pub fn sample(s: Surface<'_>, count: usize, seed: u64) -> Vec<Vec3> {
     };
     let total: f64 = s.triangles.iter().map(area).sum();
     if total <= 0.0 || count == 0 {
-        return out;
+        return;
     }
-    for t in s.triangles {
+    for (i, t) in s.triangles.iter().enumerate() {
         let share = area(t) / total * count as f64;
         let n = share.floor() as usize + usize::from(rng.unit() < share.fract());
         let [a, b, c] = t.map(|v| s.positions[v as usize]);
@@ -193,10 +213,9 @@ pub fn sample(s: Surface<'_>, count: usize, seed: u64) -> Vec<Vec3> {
             if u + v > 1.0 {
                 (u, v) = (1.0 - u, 1.0 - v);
             }
-            out.push(a + (b - a) * u + (c - a) * v);
+            emit(a + (b - a) * u + (c - a) * v, i as u32, [1.0 - u - v, u, v]);
         }
     }
-    out
 }
 
 /// SplitMix64: a tiny seeded generator, enough for sampling.
