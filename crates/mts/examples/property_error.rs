@@ -26,7 +26,10 @@ const MODELS: [&str; 3] = ["spot.obj", "pirate.obj", "beetle.obj"];
 const SHARES: [f64; 2] = [0.1, 0.01];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let usage = "usage: property_error [--models DIR] [--uv-weight W] [--normal-weight W]";
+    let usage = "usage: property_error [--models DIR] [--uv-weight W] [--normal-weight W] \
+                 [--our-uv-weight W] [--our-normal-weight W] [--samples N]";
+    let mut ours = SimplifyOptions::default();
+    let mut samples = DEFAULT_SAMPLES;
     let mut dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
     let mut weights = AttributeWeights::default();
     let mut args = std::env::args().skip(1);
@@ -36,13 +39,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--models" => dir = PathBuf::from(value),
             "--uv-weight" => weights.uv = value.parse()?,
             "--normal-weight" => weights.normal = value.parse()?,
+            "--our-uv-weight" => ours.attribute_weights.uv = value.parse()?,
+            "--our-normal-weight" => ours.attribute_weights.normal = value.parse()?,
+            "--samples" => samples = value.parse()?,
             _ => return Err(usage.into()),
         }
     }
     println!(
-        "meshoptimizer weights: normal {}, uv {}, colour {}; {DEFAULT_SAMPLES} samples a side; \
-         each pair is ours/meshoptimizer",
-        weights.normal, weights.uv, weights.color
+        "meshoptimizer weights: normal {}, uv {}, colour {}; ours: normal {}, uv {}, colour {}; \
+         {samples} samples a side; each pair is ours/meshoptimizer",
+        weights.normal,
+        weights.uv,
+        weights.color,
+        ours.attribute_weights.normal,
+        ours.attribute_weights.uv,
+        ours.attribute_weights.color
     );
     println!(
         "{:<11} {:>5} {:>9} {:>15} {:>15} {:>13} {:>13} {:>11} {:>13} {:>13}",
@@ -63,7 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     for name in MODELS {
         let (mesh, _) = load(&dir.join(name), options)?;
-        let collapses = mts::simplify(&mesh, &SimplifyOptions::default()).collapses;
+        let collapses = mts::simplify(&mesh, &ours).collapses;
         for share in SHARES {
             print!("{name:<11} {:>4}% ", share * 100.0);
             if let Some(why) = refusal(&mesh) {
@@ -77,18 +88,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 triangles: theirs,
                 ..mesh.clone()
             };
-            row(&mesh, &ours, &theirs);
+            row(&mesh, &ours, &theirs, samples);
         }
     }
     Ok(())
 }
 
 /// Prints the rest of a row: `ours` and `theirs` measured against `mesh`.
-fn row(mesh: &Mesh, ours: &Mesh, theirs: &Mesh) {
-    let geometry = |lod: &Mesh| surface_distance(mesh.into(), lod.into(), DEFAULT_SAMPLES);
+fn row(mesh: &Mesh, ours: &Mesh, theirs: &Mesh, samples: usize) {
+    let geometry = |lod: &Mesh| surface_distance(mesh.into(), lod.into(), samples);
     let (d_ours, d_theirs) = (geometry(ours), geometry(theirs));
-    let p_ours = property_error(mesh, ours, DEFAULT_SAMPLES);
-    let p_theirs = property_error(mesh, theirs, DEFAULT_SAMPLES);
+    let p_ours = property_error(mesh, ours, samples);
+    let p_theirs = property_error(mesh, theirs, samples);
     let pair = |a: Option<f64>, b: Option<f64>, digits: usize| match (a, b) {
         (Some(a), Some(b)) => format!("{a:.digits$}/{b:.digits$}"),
         _ => "-".to_owned(),

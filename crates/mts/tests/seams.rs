@@ -225,3 +225,34 @@ fn generated_properties_are_valid_and_the_torus_seams_stay_closed() {
         }
     }
 }
+
+/// On a flat grid whose texture coordinates bend (u = e^4x), geometry
+/// costs nothing and only the attribute quadrics tell contractions apart:
+/// with them the texture coordinates are kept better.
+#[test]
+fn attribute_quadrics_lower_uv_error_where_geometry_is_silent() {
+    use glam::Vec2;
+    let g: mts::mesh::generate::Generated = "grid:5000".parse().unwrap();
+    let mut mesh = g.build_with_properties();
+    let uvs = mesh.properties.uvs.as_mut().unwrap();
+    for t in uvs.iter_mut() {
+        *t = Vec2::new((4.0 * t.x).exp() / 54.6, t.y);
+    }
+    let error_at = |uv: f32| {
+        let mut o = SimplifyOptions::default();
+        o.attribute_weights = mts::simplify::AttributeWeights {
+            uv,
+            normal: 0.0,
+            color: 0.0,
+        };
+        let c = simplify(&mesh, &o).collapses;
+        let at = c.mesh_at(&mesh, c.lod_for_ratio(0.05));
+        mts::distance::property_error(&mesh, &at, 20_000)
+            .uv
+            .unwrap()
+            .rms
+    };
+    // Measured: 0.0035 without, 0.00031 at weight 0.2, 0.000066 at 1.
+    let (without, with) = (error_at(0.0), error_at(0.2));
+    assert!(with < 0.2 * without, "without {without}, with {with}");
+}

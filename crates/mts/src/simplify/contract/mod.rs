@@ -125,9 +125,9 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
         }
         return result;
     }
-    let seamed = !mesh.properties.position_ids.is_empty();
+    let with_properties = !mesh.properties.is_empty();
     match options.placement {
-        Placement::Endpoint if seamed => contract_points(mesh, options),
+        Placement::Endpoint if with_properties => contract_points(mesh, options),
         Placement::Endpoint => contract::<Endpoint>(mesh, options),
         Placement::Optimal => contract::<Optimal>(mesh, options),
     }
@@ -140,12 +140,19 @@ fn contract<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplification 
     c.finish()
 }
 
-/// The whole sequence of a mesh with seams, contracted point by point
-/// (`seams.rs`). Optimal placement does not take this path yet: it would
+/// The whole sequence of a mesh with properties, contracted point by point
+/// (`seams.rs`; every vertex its own point when none is split), with the
+/// attribute quadrics in the cost (`attributes.rs`). Optimal placement does not take this path yet: it would
 /// need properties for the vertices it creates, and runs on the vertices
 /// as they are (a seam is then a border, and may open).
 fn contract_points(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
-    let ids = &mesh.properties.position_ids;
+    let identity: Vec<u32>;
+    let ids = if mesh.properties.position_ids.is_empty() {
+        identity = (0..mesh.vertex_count() as u32).collect();
+        &identity
+    } else {
+        &mesh.properties.position_ids
+    };
     let points = ids.iter().max().map_or(0, |&m| m as usize + 1);
     let mut positions = vec![Vec3::ZERO; points];
     for (v, &id) in ids.iter().enumerate() {
