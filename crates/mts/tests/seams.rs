@@ -239,11 +239,13 @@ fn attribute_quadrics_lower_uv_error_where_geometry_is_silent() {
         *t = Vec2::new((4.0 * t.x).exp() / 54.6, t.y);
     }
     let error_at = |uv: f32| {
-        let mut o = SimplifyOptions::default();
-        o.attribute_weights = mts::simplify::AttributeWeights {
-            uv,
-            normal: 0.0,
-            color: 0.0,
+        let o = SimplifyOptions {
+            attribute_weights: mts::simplify::AttributeWeights {
+                uv,
+                normal: 0.0,
+                color: 0.0,
+            },
+            ..SimplifyOptions::default()
         };
         let c = simplify(&mesh, &o).collapses;
         let at = c.mesh_at(&mesh, c.lod_for_ratio(0.05));
