@@ -395,12 +395,16 @@ impl MeshSource {
             Ok((path.display().to_string(), mesh, report))
         } else {
             let g = self.generated.unwrap_or(Generated::DEFAULT);
-            let mesh = g.build();
+            let mesh = if self.properties {
+                g.build_with_properties()
+            } else {
+                g.build()
+            };
             let raw = mts::mesh::RawMesh {
                 positions: mesh.positions,
                 triangles: mesh.triangles,
                 degenerate_in_source: 0,
-                properties: Default::default(),
+                properties: mesh.properties,
             };
             let (mesh, report) = mts::mesh::clean(raw, clean, &g.to_string())?;
             Ok((format!("generated {g}"), mesh, report))
