@@ -1,6 +1,8 @@
 //! What the loader fuzz targets check on every mesh a reader accepted: it
 //! cleans to a valid mesh (or to a clean error), never a panic; a small one
-//! is also stripified and the strips must draw exactly its triangles.
+//! is also stripified (the strips must draw exactly its triangles) and
+//! simplified (the sequence and its middle LoD must be valid: with
+//! properties, through the seam-keeping path).
 
 pub fn check(raw: mts::mesh::RawMesh) {
     let Ok((mesh, _report)) = mts::mesh::clean(raw, Default::default(), "fuzz") else {
@@ -14,5 +16,11 @@ pub fn check(raw: mts::mesh::RawMesh) {
             mts::strip::sorted_canonical(&mesh.triangles),
             "the strips do not draw exactly the mesh's triangles"
         );
+        let s = mts::simplify(&mesh, &Default::default());
+        s.collapses.validate().unwrap();
+        s.collapses
+            .mesh_at(&mesh, s.collapses.max_lod() / 2)
+            .validate()
+            .unwrap();
     }
 }
