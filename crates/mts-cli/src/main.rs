@@ -816,7 +816,7 @@ fn distance(args: &DistanceArgs) -> Result<()> {
             "forward": d.forward,
             "backward": d.backward,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        println!("{v}");
     } else {
         println!(
             "Hausdorff {:.6}  RMS {:.6}  (relative to the reference's diagonal; \
@@ -1236,12 +1236,32 @@ fn info(args: &InfoArgs) -> Result<()> {
             "quality_ratio": ours / theirs,
         }));
     }
+    let props = model.properties();
+    let mut streams = Vec::new();
+    for (present, name) in [
+        (props.normals.is_some(), "normals"),
+        (props.uvs.is_some(), "uvs"),
+        (props.colors.is_some(), "colors"),
+    ] {
+        if present {
+            streams.push(name);
+        }
+    }
+    let points = props
+        .position_ids
+        .iter()
+        .max()
+        .map_or(model.collapses().vertex_count(), |&m| m as usize + 1);
+    let texture = props.texture.as_ref().map(|t| match t {
+        mts::mesh::Texture::File(f) => f.display().to_string(),
+        mts::mesh::Texture::Embedded { mime, bytes } => {
+            format!("embedded {mime} ({} bytes)", bytes.len())
+        }
+    });
     if args.json {
-        println!(
-            "{}",
-            json!({
-                "file": args.model.display().to_string(),
-                "file_bytes": file_bytes,
+        let mut v = json!({
+            "file": args.model.display().to_string(),
+            "file_bytes": file_bytes,
                 "raw_bytes": model.raw_bytes(),
                 "load_ms": load_ms,
                 "vertices": model.positions().len(),
@@ -1251,10 +1271,19 @@ fn info(args: &InfoArgs) -> Result<()> {
                 "strips": st.strips,
                 "nodes": st.nodes,
                 "arcs": st.arcs,
-                "memory_bytes": st.memory_bytes,
-                "levels": levels,
-            })
-        );
+            "memory_bytes": st.memory_bytes,
+            "levels": levels,
+        });
+        // Only for a model with properties, so that the output of the
+        // others stays as it was.
+        if !props.is_empty() {
+            v["properties"] = json!({
+                "streams": streams,
+                "points": points,
+                "texture": texture,
+            });
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         println!(
             "{}: {} bytes ({:.2} x raw), loaded and built in {load_ms:.1} ms",
@@ -1264,6 +1293,17 @@ fn info(args: &InfoArgs) -> Result<()> {
         );
         println!("  {} vertices, {} triangles, {} LoDs, {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
             model.positions().len(), model.triangle_count(0), model.max_lod() + 1, model.band_count(), st.strips, st.nodes, st.arcs, st.memory_bytes as f64 / 1e6);
+        if !props.is_empty() {
+            println!(
+                "  properties: {} on {points} points; texture: {}",
+                if streams.is_empty() {
+                    "none".to_string()
+                } else {
+                    streams.join(", ")
+                },
+                texture.as_deref().unwrap_or("none")
+            );
+        }
         println!(
             "  {:>6} {:>7} {:>9} {:>9} {:>11} {:>7}",
             "share", "LoD", "triangles", "idx/tri", "restripify", "ratio"
