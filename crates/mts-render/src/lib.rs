@@ -8,7 +8,10 @@
 //! - [`strip_renderer`]: [`StripRenderer`], which embeds into a caller's own
 //!   device, queue and render pass; strips with primitive restart (or
 //!   degenerate stitching where the backend ignores restart) and triangle
-//!   lists through one pipeline layout and one shader (`shaders/mesh.wgsl`).
+//!   lists through one pipeline layout and one shader (`shaders/mesh.wgsl`);
+//!   vertex normals, colours and UVs of a mesh's properties.
+//! - [`texture`]: the base-colour texture ([`Appearance`]): decoded PNG or
+//!   JPEG, or a checker; mipmapped on the CPU, RGBA8 sRGB.
 //! - [`headless`]: render to a texture, read it back, write a PNG.
 //! - [`camera`]: a default camera that frames a bounding box.
 //! - [`scene`]: many instances of one model, each with its own LoD and
@@ -21,12 +24,14 @@ pub mod gpu;
 pub mod headless;
 pub mod scene;
 pub mod strip_renderer;
+pub mod texture;
 
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{HeadlessTarget, Image};
 pub use scene::{FrameStats, InstanceId, InstancedScene, ModelId};
-pub use strip_renderer::{RendererConfig, StripRenderer, Upload};
+pub use strip_renderer::{RendererConfig, StripRenderer, Upload, VERTEX_BYTES};
+pub use texture::Appearance;
 /// The wgpu this renderer is built with, so that embedders use the same
 /// version.
 pub use wgpu;

@@ -8,10 +8,21 @@
 //! camera uniform, back-face culling and CCW front faces, so every method
 //! goes through one code path and a winding error shows as a hole. Indices
 //! are `u16` when every vertex index fits below the `u16` restart value.
+//!
+//! One vertex layout serves every mesh, with or without properties:
+//! position and normal (`f32`), UV (`f32`), linear colour (`Unorm16x4`),
+//! 40 bytes a vertex where position and normal alone took 24. Chosen over a
+//! second vertex stream and pipeline for meshes with properties because
+//! one pipeline keeps strips, lists, the scene and the oracle images on one
+//! code path; the cost is 16 bytes a vertex on meshes without properties.
+//! `Unorm16` keeps linear colours within 1/65535 (8 bits would band the
+//! darks) at half the bytes of `f32`.
 
 use super::camera::{Camera, Shading};
 use super::gpu::StripMode;
+use super::texture::{self, Appearance};
 use glam::Vec3;
+use mts::mesh::Properties;
 use mts::model::Extractor;
 use mts::strip::encode::{stitch_restart_buffer, RESTART_U16, RESTART_U32};
 use mts::{Error, Result};
@@ -52,6 +63,8 @@ struct CameraUniform {
     view_proj: [[f32; 4]; 4],
     light_dir: [f32; 4],
     colour: [f32; 4],
+    /// x: 1 to sample the texture, y: 1 to use the vertex colours.
+    material: [f32; 4],
 }
 
 /// Surface colour of a new [`StripRenderer`] (linear RGB, a warm light
@@ -62,12 +75,19 @@ pub const DEFAULT_COLOUR: Vec3 = Vec3::new(0.85, 0.78, 0.65);
 /// stride of vertex buffer slot 1.
 pub const INSTANCE_BYTES: u64 = 64;
 
-/// Interleaved vertex: position then normal (24 bytes).
+/// Bytes of one vertex in the vertex buffer (see the module docs).
+pub const VERTEX_BYTES: usize = std::mem::size_of::<Vertex>();
+
+/// Interleaved vertex: position, normal, UV, colour (40 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct Vertex {
     position: [f32; 3],
     normal: [f32; 3],
+    /// `v` up (v = 0 is the image's bottom row); zero without UVs.
+    uv: [f32; 2],
+    /// Linear RGBA, `Unorm16x4`; white without colours.
+    colour: [u16; 4],
 }
 
 /// Draws one mesh's strips or triangle lists into a caller's render pass.
@@ -89,6 +109,12 @@ pub struct StripRenderer {
     vertices: Vec<Vertex>,
     /// Linear RGB surface colour, written with the camera.
     colour: Vec3,
+    /// The shader's `material` flags: texture, vertex colours.
+    material: [f32; 4],
+    /// Size of the base-colour texture drawn; `None` when untextured.
+    texture_size: Option<(u32, u32)>,
+    /// Why a texture or property is not drawn, one sentence each.
+    warnings: Vec<String>,
     /// One identity transform: what [`StripRenderer::draw`] binds to slot 1.
     identity_instance: wgpu::Buffer,
     uniform_buffer: wgpu::Buffer,
@@ -111,7 +137,9 @@ pub struct StripRenderer {
 impl StripRenderer {
     /// Uploads `positions` with area-weighted vertex normals computed from
     /// `triangles` (the full-resolution mesh, so that the shading does not
-    /// change with the LoD) and builds both pipelines.
+    /// change with the LoD) and builds both pipelines: the surface in
+    /// [`DEFAULT_COLOUR`], untextured. [`StripRenderer::with_properties`]
+    /// with empty properties.
     ///
     /// # Errors
     /// [`Error::InvalidArgument`] when there are no vertices, more than
@@ -125,6 +153,51 @@ impl StripRenderer {
         config: &RendererConfig,
         positions: &[Vec3],
         triangles: &[[u32; 3]],
+    ) -> Result<StripRenderer> {
+        StripRenderer::with_properties(
+            device,
+            queue,
+            config,
+            positions,
+            triangles,
+            &Properties::default(),
+            &Appearance::default(),
+        )
+    }
+
+    /// [`StripRenderer::new`] drawing a mesh's vertex properties: its
+    /// normals where present and non-zero (computed from `triangles`
+    /// otherwise), its colours (white without), its UVs (zero without) and
+    /// its base-colour texture, or the checker of
+    /// [`Appearance::checker`]. A fragment's colour is surface colour ×
+    /// texture × vertex colour × the Lambert shade; the surface colour
+    /// starts white when a texture or vertex colours are drawn (so they
+    /// show as authored), [`DEFAULT_COLOUR`] otherwise.
+    ///
+    /// The texture is decoded (PNG or JPEG), mipmapped on the CPU and
+    /// uploaded as RGBA8 sRGB. A texture that cannot be drawn (missing or
+    /// corrupt file, another format, a side above the device's
+    /// `max_texture_dimension_2d`, no UVs) is not an error: the mesh is
+    /// drawn untextured and [`StripRenderer::warnings`] says why, naming
+    /// the image.
+    ///
+    /// # Errors
+    /// As [`StripRenderer::new`], and [`Error::InvalidArgument`] when
+    /// `properties` breaks an invariant of [`Properties::validate`] for
+    /// `positions` (a stream of another length, a non-unit normal, a
+    /// colour outside 0..=1).
+    ///
+    /// Cost: O(vertices + triangles + texels): the decode and the mip
+    /// chain (4/3 of the image, in memory until uploaded) dominate for a
+    /// textured mesh.
+    pub fn with_properties(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: &RendererConfig,
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        properties: &Properties,
+        appearance: &Appearance,
     ) -> Result<StripRenderer> {
         if positions.is_empty() || positions.len() >= RESTART_U32 as usize {
             return Err(Error::InvalidArgument(format!(
@@ -142,15 +215,10 @@ impl StripRenderer {
                 positions.len()
             )));
         }
-        let normals = super::vertex_normals(positions, triangles);
-        let vertices: Vec<Vertex> = positions
-            .iter()
-            .zip(&normals)
-            .map(|(p, n)| Vertex {
-                position: p.to_array(),
-                normal: n.to_array(),
-            })
-            .collect();
+        properties
+            .validate(positions)
+            .map_err(|e| Error::InvalidArgument(format!("vertex properties: {e}")))?;
+        let vertices = interleave(positions, triangles, properties);
         let vertex_bytes: &[u8] = bytemuck::cast_slice(&vertices);
         check_size(device, vertex_bytes.len(), "vertex buffer")?;
         let vertex_buffer = device.create_buffer(&wgpu::BufferDescriptor {
@@ -160,6 +228,29 @@ impl StripRenderer {
             mapped_at_creation: false,
         });
         queue.write_buffer(&vertex_buffer, 0, vertex_bytes);
+        let mut warnings = Vec::new();
+        let max_dimension = device.limits().max_texture_dimension_2d;
+        let base = texture::base_colour(properties, appearance, max_dimension, &mut warnings);
+        let texture_size = base.as_ref().map(|b| (b.width, b.height));
+        let texture_view = match base {
+            Some(base) => {
+                texture::upload(device, queue, &texture::mip_chain(base), "mts base colour")
+            }
+            None => texture::upload(device, queue, &[texture::white()], "mts white"),
+        };
+        let sampler = texture::sampler(device);
+        let colours = properties.colors.is_some();
+        let material = [
+            f32::from(u8::from(texture_size.is_some())),
+            f32::from(u8::from(colours)),
+            0.0,
+            0.0,
+        ];
+        let colour = if texture_size.is_some() || colours {
+            Vec3::ONE
+        } else {
+            DEFAULT_COLOUR
+        };
         let identity_instance = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("mts identity instance"),
             size: INSTANCE_BYTES,
@@ -178,25 +269,53 @@ impl StripRenderer {
             mapped_at_creation: false,
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("mts camera layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
+            label: Some("mts camera and material layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
                 },
-                count: None,
-            }],
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mts camera"),
+            label: Some("mts camera and material"),
             layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform_buffer.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniform_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&texture_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+            ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("mts pipeline layout"),
@@ -237,7 +356,10 @@ impl StripRenderer {
             vertex_buffer,
             vertices,
             vertex_count: positions.len(),
-            colour: DEFAULT_COLOUR,
+            colour,
+            material,
+            texture_size,
+            warnings,
             identity_instance,
             uniform_buffer,
             bind_group,
@@ -298,6 +420,21 @@ impl StripRenderer {
         Ok(renderer)
     }
 
+    /// Why something of the properties is not drawn, one sentence each
+    /// naming the image (e.g. `texture /a/b.png: cannot read it (...);
+    /// drawn untextured`); empty when everything asked for is drawn.
+    #[must_use]
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Width and height of the base-colour texture drawn (level 0), or
+    /// `None` when untextured.
+    #[must_use]
+    pub fn texture_size(&self) -> Option<(u32, u32)> {
+        self.texture_size
+    }
+
     /// The formats and strip mode it was built with.
     #[must_use]
     pub fn config(&self) -> &RendererConfig {
@@ -330,7 +467,9 @@ impl StripRenderer {
     }
 
     /// Sets the surface colour (linear RGB, each 0..1) that the next
-    /// [`StripRenderer::set_camera`] writes; [`DEFAULT_COLOUR`] until then.
+    /// [`StripRenderer::set_camera`] writes; until then [`DEFAULT_COLOUR`],
+    /// or white when textured or vertex-coloured
+    /// ([`StripRenderer::with_properties`]).
     pub fn set_colour(&mut self, colour: Vec3) {
         self.colour = colour;
     }
@@ -349,6 +488,7 @@ impl StripRenderer {
                 })
                 .to_array(),
             colour: self.colour.extend(1.0).to_array(),
+            material: self.material,
         };
         queue.write_buffer(&self.uniform_buffer, 0, bytemuck::bytes_of(&u));
     }
@@ -480,8 +620,8 @@ impl StripRenderer {
         Ok(upload)
     }
 
-    /// Moves the first `positions.len()` vertices to `positions` (normals
-    /// kept), e.g. a geomorph's interpolated positions
+    /// Moves the first `positions.len()` vertices to `positions` (normals,
+    /// UVs and colours kept), e.g. a geomorph's interpolated positions
     /// ([`mts::baselines::MultilevelMesh::geomorph`]) drawn with the finer
     /// LoD's triangles.
     ///
@@ -700,6 +840,46 @@ pub(crate) fn write_index_range(
     }
 }
 
+/// The vertex buffer's contents: `positions` with the normals of
+/// `properties` where present and non-zero, else area-weighted ones from
+/// `triangles`; UVs (zero without); colours rounded to 16 bits (white
+/// without). Precondition: `properties` is valid for `positions`.
+///
+/// Cost: O(vertices + triangles); the computed normals are skipped when
+/// every vertex has its own.
+fn interleave(positions: &[Vec3], triangles: &[[u32; 3]], properties: &Properties) -> Vec<Vertex> {
+    let given = properties.normals.as_deref();
+    let computed = match given {
+        Some(normals) if !normals.contains(&Vec3::ZERO) => Vec::new(),
+        _ => super::vertex_normals(positions, triangles),
+    };
+    let unorm16 = |c: f32| (c.clamp(0.0, 1.0) * 65535.0).round() as u16;
+    positions
+        .iter()
+        .enumerate()
+        .map(|(v, p)| {
+            let normal = match given.map(|n| n[v]) {
+                Some(n) if n != Vec3::ZERO => n,
+                _ => computed[v],
+            };
+            let uv = properties
+                .uvs
+                .as_ref()
+                .map_or([0.0; 2], |t| t[v].to_array());
+            let colour = properties
+                .colors
+                .as_ref()
+                .map_or([u16::MAX; 4], |c| c[v].to_array().map(unorm16));
+            Vertex {
+                position: p.to_array(),
+                normal: normal.to_array(),
+                uv,
+                colour,
+            }
+        })
+        .collect()
+}
+
 fn to_u32_range(r: Range<usize>) -> Range<u32> {
     r.start as u32..r.end as u32
 }
@@ -733,7 +913,9 @@ fn create_pipeline(
                 Some(wgpu::VertexBufferLayout {
                     array_stride: std::mem::size_of::<Vertex>() as u64,
                     step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                    attributes: &wgpu::vertex_attr_array![
+                        0 => Float32x3, 1 => Float32x3, 6 => Float32x2, 7 => Unorm16x4
+                    ],
                 }),
                 Some(wgpu::VertexBufferLayout {
                     array_stride: INSTANCE_BYTES,
@@ -766,4 +948,45 @@ fn create_pipeline(
         multiview_mask: None,
         cache: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Vec2, Vec4};
+
+    #[test]
+    fn vertices_take_given_normals_and_fill_in_the_rest() {
+        // 3---2
+        // | / |   z = 0, CCW from +z: computed normals are +z
+        // 0---1
+        let p = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let t = [[0, 1, 2], [0, 2, 3]];
+        let plain = interleave(&p, &t, &Properties::default());
+        assert_eq!(VERTEX_BYTES, 40);
+        assert!(plain
+            .iter()
+            .all(|v| v.normal == [0.0, 0.0, 1.0] && v.uv == [0.0; 2] && v.colour == [u16::MAX; 4]));
+        // A zero normal is "none": that vertex alone gets the computed one.
+        let properties = Properties {
+            normals: Some(vec![Vec3::X, Vec3::ZERO, Vec3::Y, Vec3::NEG_Z]),
+            uvs: Some(vec![Vec2::new(0.5, 2.0); 4]),
+            colors: Some(vec![Vec4::new(0.0, 0.5, 1.0, 0.25); 4]),
+            ..Properties::default()
+        };
+        let v = interleave(&p, &t, &properties);
+        let normals: Vec<[f32; 3]> = v.iter().map(|v| v.normal).collect();
+        assert_eq!(
+            normals,
+            [
+                [1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, -1.0]
+            ]
+        );
+        assert_eq!(v[3].uv, [0.5, 2.0]);
+        // 0.5 * 65535 = 32767.5 rounds up; 0.25 * 65535 = 16383.75.
+        assert_eq!(v[3].colour, [0, 32768, 65535, 16384]);
+    }
 }

@@ -11,6 +11,7 @@
 
 #[path = "../../mts/tests/common/mod.rs"]
 mod common;
+mod support;
 
 use mts::mesh::generate::Generated;
 use mts::model::{build, BuildOptions};
@@ -20,6 +21,7 @@ use mts_render::{
     Camera, FrameStats, Gpu, Image, InstanceId, InstancedScene, ModelId, RendererConfig, Shading,
     StripMode, StripRenderer,
 };
+use support::{gpu_on, required_gpu};
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
@@ -49,12 +51,6 @@ fn gpu() -> Option<Gpu> {
         }
         Err(e) => panic!("GPU setup failed: {e}"),
     }
-}
-
-/// Whether `MTS_REQUIRE` (set by `.ci/run`) names `gpu`: a missing
-/// adapter then fails instead of skipping.
-fn required_gpu() -> bool {
-    std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w.trim() == "gpu"))
 }
 
 fn model_of(mesh: &Mesh) -> MtsModel {
@@ -642,23 +638,6 @@ fn host_moves_adds_and_removes_instances_of_two_models() {
         image.foreground_pixels()
     );
     assert_eq!(difference(&image, &expected), (0, 0));
-}
-
-/// The GPU on `backends`, or `None` with a message (a failure when
-/// `MTS_REQUIRE` names gpu).
-fn gpu_on(backends: wgpu::Backends, what: &str) -> Option<Gpu> {
-    match Gpu::new_headless_on(backends) {
-        Ok(gpu) => Some(gpu),
-        Err(Error::NoAdapter(why)) => {
-            assert!(
-                !required_gpu(),
-                "MTS_REQUIRE names gpu: no {what} adapter ({why})"
-            );
-            eprintln!("skipped: no {what} adapter ({why})");
-            None
-        }
-        Err(e) => panic!("{what} setup failed: {e}"),
-    }
 }
 
 /// Issue 19: the instanced scene refused backends without primitive

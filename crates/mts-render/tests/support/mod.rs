@@ -1,0 +1,29 @@
+//! The GPU helpers shared by the renderer's integration tests: an adapter
+//! on the backends asked for, or a skip with a message when there is none
+//! (a failure when `MTS_REQUIRE` names `gpu`).
+
+use mts::Error;
+use mts_render::Gpu;
+
+/// Whether `MTS_REQUIRE` (set by `.ci/run`) names `gpu`: a missing
+/// adapter then fails instead of skipping.
+pub fn required_gpu() -> bool {
+    std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w.trim() == "gpu"))
+}
+
+/// The GPU on `backends`, or `None` with a message (a failure when
+/// `MTS_REQUIRE` names gpu).
+pub fn gpu_on(backends: wgpu::Backends, what: &str) -> Option<Gpu> {
+    match Gpu::new_headless_on(backends) {
+        Ok(gpu) => Some(gpu),
+        Err(Error::NoAdapter(why)) => {
+            assert!(
+                !required_gpu(),
+                "MTS_REQUIRE names gpu: no {what} adapter ({why})"
+            );
+            eprintln!("skipped: no {what} adapter ({why})");
+            None
+        }
+        Err(e) => panic!("{what} setup failed: {e}"),
+    }
+}
