@@ -95,6 +95,11 @@ pub struct RenderArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
+    /// Texture the model with a checker (shows UV distortion) instead of
+    /// its own texture; needs texture coordinates (`--properties`, or a
+    /// model built with them).
+    #[arg(long, conflicts_with = "scene")]
+    checker: bool,
     /// Draw N instances of the model on a ground plane instead (each with
     /// its own LoD from its projected size; 1000 when N is left out).
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
@@ -135,7 +140,13 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             (r, source.indices().len(), upload)
         }
         None => {
-            let mut r = StripRenderer::for_model(device, queue, &config, &model)?;
+            let appearance = mts_render::texture::Appearance {
+                checker: args.checker,
+            };
+            let mut r = StripRenderer::for_model_with(device, queue, &config, &model, &appearance)?;
+            for w in r.warnings() {
+                eprintln!("{w}");
+            }
             if args.method == Method::Mts {
                 let mut ex = Extractor::new(&model);
                 ex.set_lod(lod);
@@ -305,6 +316,11 @@ pub struct ViewArgs {
     /// Quit after this many frames (scripted runs).
     #[arg(long)]
     frames: Option<u64>,
+    /// Texture the model with a checker (shows UV distortion) instead of
+    /// its own texture; needs texture coordinates (`--properties`, or a
+    /// model built with them).
+    #[arg(long)]
+    checker: bool,
 }
 
 /// `mts view`: opens the viewer window.
@@ -313,7 +329,9 @@ pub fn view(args: &ViewArgs) -> Result<()> {
     let (name, model) = args.source.model()?;
     let content = match args.scene {
         Some(n) => ViewerContent::Scene(n),
-        None => ViewerContent::Model,
+        None => ViewerContent::Model {
+            checker: args.checker,
+        },
     };
     let report = run(&model, content, &format!("mts view: {name}"), args.frames)?;
     println!(

@@ -35,8 +35,12 @@ const TITLE_PERIOD: f64 = 0.5;
 /// What the viewer shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ViewerContent {
-    /// The model alone.
-    Model,
+    /// The model alone, with its properties (and the checker texture
+    /// instead of its own when `checker` is set).
+    Model {
+        /// Show the checker texture.
+        checker: bool,
+    },
     /// This many instances of it on a ground plane.
     Scene(usize),
 }
@@ -306,8 +310,18 @@ impl<'m> State<'m> {
             strip_mode: report.strip_mode,
         };
         let (drawn, centre, radius) = match content {
-            ViewerContent::Model => {
-                let renderer = StripRenderer::for_model(&device, &queue, &renderer_config, model)?;
+            ViewerContent::Model { checker } => {
+                let appearance = mts_render::texture::Appearance { checker };
+                let renderer = StripRenderer::for_model_with(
+                    &device,
+                    &queue,
+                    &renderer_config,
+                    model,
+                    &appearance,
+                )?;
+                for w in renderer.warnings() {
+                    eprintln!("{w}");
+                }
                 let (lo, hi) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
                 let drawn = Drawn::Model {
                     renderer,

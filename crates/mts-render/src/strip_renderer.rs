@@ -387,8 +387,32 @@ impl StripRenderer {
         config: &RendererConfig,
         model: &mts::MtsModel,
     ) -> Result<StripRenderer> {
+        StripRenderer::for_model_with(device, queue, config, model, &Appearance::default())
+    }
+
+    /// [`StripRenderer::for_model`] drawing the model's properties
+    /// ([`mts::MtsModel::properties`]: normals, colours, texture) as
+    /// `appearance` asks. A model whose optimal placement created vertices
+    /// has no properties for them and is drawn without its properties.
+    ///
+    /// # Errors
+    /// As [`StripRenderer::with_properties`].
+    pub fn for_model_with(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: &RendererConfig,
+        model: &mts::MtsModel,
+        appearance: &Appearance,
+    ) -> Result<StripRenderer> {
         let triangles = model.base_strips().triangles();
-        StripRenderer::new(device, queue, config, model.positions(), &triangles)
+        let positions = model.positions();
+        let none = mts::mesh::Properties::default();
+        let props = model.properties();
+        let fits = props.is_empty() || props.validate(positions).is_ok();
+        let props = if fits { props } else { &none };
+        StripRenderer::with_properties(
+            device, queue, config, positions, &triangles, props, appearance,
+        )
     }
 
     /// [`StripRenderer::new`] for any [`mts::LodSource`]: its own vertices
