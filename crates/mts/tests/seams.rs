@@ -258,3 +258,33 @@ fn attribute_quadrics_lower_uv_error_where_geometry_is_silent() {
     let (without, with) = (error_at(0.0), error_at(0.2));
     assert!(with < 0.2 * without, "without {without}, with {with}");
 }
+
+/// glTF and PLY cannot say which vertices a seam split: loading them with
+/// properties takes equal positions as one point, so a written seamed
+/// torus comes back with the points it had.
+#[test]
+fn written_seams_come_back_as_points_from_every_format() {
+    use mts::mesh::io::{load, save_mesh, LoadOptions};
+    let mesh: Mesh = "torus:2000"
+        .parse::<mts::mesh::generate::Generated>()
+        .unwrap()
+        .build_with_properties();
+    let points = |m: &Mesh| 1 + *m.properties.position_ids.iter().max().unwrap() as usize;
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("seams_formats");
+    std::fs::create_dir_all(&dir).unwrap();
+    let options = LoadOptions {
+        properties: true,
+        ..LoadOptions::default()
+    };
+    let mut formats = vec!["obj", "ply"];
+    if cfg!(feature = "gltf") {
+        formats.push("glb");
+    }
+    for ext in formats {
+        let path = dir.join(format!("torus.{ext}"));
+        save_mesh(&mesh, &path).unwrap();
+        let (back, _) = load(&path, options).unwrap();
+        assert_eq!(back.vertex_count(), mesh.vertex_count(), "{ext}");
+        assert_eq!(points(&back), points(&mesh), "{ext}");
+    }
+}
