@@ -7,8 +7,8 @@
 
 use crate::results::{
     BuildMs, Bytes, Distance, Extraction, FastSimplification, FastSimplificationRun, Figure6Row,
-    Level, Machine, MethodRow, Model, PeerDistance, Quality, Results, Scale, ScaleExponent,
-    ScaleRow, Scene, Simplify, StripRow, Stripify,
+    Level, Machine, MethodRow, Model, PeerDistance, PropertyRow, PropertySide, Quality, Results,
+    Scale, ScaleExponent, ScaleRow, Scene, Simplify, StripRow, Stripify,
 };
 use anyhow::{Context, Result};
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 2;
+pub const SCHEMA_VERSION: u32 = 3;
 
 /// Shares of the full triangle count reported in Tables 3–4.
 const SHARES: [f64; 6] = mts::methods::SHARES;
@@ -148,6 +148,8 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
         progress("fast-simplification");
         Some(fast_simplification(&options.models)?)
     };
+    progress("properties");
+    let properties = measure_properties(&options.models, options.quick)?;
     Ok(Results {
         schema: SCHEMA_VERSION,
         command: options.command.clone(),
@@ -158,7 +160,114 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
         scale,
         fast_simplification,
         scene,
+        properties,
     })
+}
+
+/// The report's section on vertex properties.
+fn property_table(s: &mut String, rows: &[PropertyRow]) {
+    let _ = writeln!(
+        s,
+        "\n## Vertex properties against meshoptimizer's `simplifyWithAttributes`\n"
+    );
+    let _ = writeln!(s, "Models loaded with `--properties` (UV and normal seams kept) and the generated `{PROPERTY_MESH}` with UVs, normals and colours; meshoptimizer's `simplifyWithAttributes` (normals 1, UV 30, colours 1) at the same triangle count. Geometric error relative to the diagonal; property error sampled like it at corresponding points, both directions pooled: UV distance, normal angle in degrees, RGBA distance (RMS; `docs/experiments/properties.md`).\n");
+    let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts / meshopt | RMS mts / meshopt | UV mts / meshopt | normal° mts / meshopt | colour mts / meshopt |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    let pair = |a: Option<f64>, b: Option<f64>, digits: usize| match (a, b) {
+        (Some(a), Some(b)) => format!("{a:.digits$} / {b:.digits$}"),
+        _ => "—".to_string(),
+    };
+    for r in rows {
+        let (m, o) = (&r.mts, &r.meshopt);
+        let _ = writeln!(
+            s,
+            "| {} | {:.0}% | {} / {} | {:.5} / {:.5} | {:.5} / {:.5} | {} | {} | {} |",
+            r.model,
+            r.share * 100.0,
+            m.triangles,
+            o.triangles,
+            m.hausdorff,
+            o.hausdorff,
+            m.rms,
+            o.rms,
+            pair(m.uv_rms, o.uv_rms, 4),
+            pair(m.normal_degrees_rms, o.normal_degrees_rms, 1),
+            pair(m.color_rms, o.color_rms, 4),
+        );
+    }
+}
+
+/// The generated mesh with properties every run measures (UV seams,
+/// normals, colours).
+const PROPERTY_MESH: &str = "torus:20k";
+
+/// Vertex properties: every model of `models` that has some (loaded with
+/// `--properties`; none with `--quick`) and the generated torus, at 10%
+/// and 1%, against meshoptimizer's `simplifyWithAttributes` at the same
+/// triangle count (where it stops above ours, ours at its count).
+///
+/// # Errors
+/// When a model cannot be loaded.
+fn measure_properties(models: &[PathBuf], quick: bool) -> Result<Vec<PropertyRow>> {
+    use mts::distance::{property_error, surface_distance};
+    use mts::peers::meshopt::{simplify_with_attributes_to_lod, AttributeWeights};
+    let g: mts::mesh::generate::Generated = PROPERTY_MESH.parse().expect("a valid generated name");
+    let mut inputs = vec![(
+        format!("generated {PROPERTY_MESH}"),
+        g.build_with_properties(),
+    )];
+    let options = mts::mesh::io::LoadOptions {
+        properties: true,
+        ..Default::default()
+    };
+    for path in models.iter().filter(|_| !quick) {
+        let (mesh, _) = mts::mesh::io::load(path, options)
+            .with_context(|| format!("cannot load {}", path.display()))?;
+        if mesh.properties.is_empty() || peers::meshopt::refusal(&mesh).is_some() {
+            continue;
+        }
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        );
+        inputs.push((name, mesh));
+    }
+    let mut rows = Vec::new();
+    for (name, mesh) in &inputs {
+        let c = mts::simplify(mesh, &Default::default()).collapses;
+        for &share in &QUALITY_SHARES {
+            let (theirs, lod) = simplify_with_attributes_to_lod(
+                mesh,
+                &c,
+                c.lod_for_ratio(share),
+                AttributeWeights::default(),
+            );
+            let ours = c.mesh_at(mesh, lod);
+            let theirs = Mesh {
+                triangles: theirs,
+                ..mesh.clone()
+            };
+            let side = |lod: &Mesh| {
+                let d = surface_distance(mesh.into(), lod.into(), SAMPLES);
+                let p = property_error(mesh, lod, SAMPLES);
+                PropertySide {
+                    triangles: lod.triangle_count() as u64,
+                    hausdorff: d.hausdorff,
+                    rms: d.rms,
+                    uv_rms: p.uv.map(|s| s.rms),
+                    normal_degrees_rms: p.normal_degrees.map(|s| s.rms),
+                    color_rms: p.color.map(|s| s.rms),
+                }
+            };
+            rows.push(PropertyRow {
+                model: name.clone(),
+                share,
+                mts: side(&ours),
+                meshopt: side(&theirs),
+            });
+        }
+    }
+    Ok(rows)
 }
 
 /// The fast-simplification peer (`crates/mts-cli/peers/fast_simplification.py`)
@@ -906,6 +1015,7 @@ pub fn report(results: &Results) -> String {
             );
         }
     }
+    property_table(&mut s, &results.properties);
     if models.iter().any(|r| r.figure6.is_some()) {
         let _ = writeln!(
             s,

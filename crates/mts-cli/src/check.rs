@@ -48,6 +48,46 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
             );
         }
     }
+    // Vertex properties: the generated torus at least, each row at one
+    // triangle count on both sides, every stream measured on both or on
+    // neither, and no error below zero.
+    need(
+        r.properties.len() >= 2 && r.properties[0].model.starts_with("generated "),
+        format!(
+            "{} property rows, the generated mesh's two first",
+            r.properties.len()
+        ),
+    );
+    for p in &r.properties {
+        let at = format!("properties {} at {}", p.model, p.share);
+        let (m, o) = (&p.mts, &p.meshopt);
+        need(
+            m.triangles > 0 && m.triangles.abs_diff(o.triangles) <= m.triangles / 50 + 2,
+            format!("{at}: triangles {} against {}", m.triangles, o.triangles),
+        );
+        need(
+            m.uv_rms.is_some() == o.uv_rms.is_some()
+                && m.normal_degrees_rms.is_some() == o.normal_degrees_rms.is_some()
+                && m.color_rms.is_some() == o.color_rms.is_some(),
+            format!("{at}: a stream measured on one side only"),
+        );
+        let values = [m.hausdorff, m.rms, o.hausdorff, o.rms];
+        let streams = [
+            m.uv_rms,
+            m.normal_degrees_rms,
+            m.color_rms,
+            o.uv_rms,
+            o.normal_degrees_rms,
+            o.color_rms,
+        ];
+        need(
+            values
+                .iter()
+                .chain(streams.iter().flatten())
+                .all(|&x| x >= 0.0),
+            format!("{at}: a negative error"),
+        );
+    }
     let methods: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
     for m in &r.models {
         let at = |section: &str| format!("{}: {section}", m.name);

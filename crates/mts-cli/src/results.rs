@@ -25,6 +25,33 @@ pub struct Results {
     pub fast_simplification: Option<FastSimplificationRun>,
     /// `null` without an adapter.
     pub scene: Option<Scene>,
+    /// Vertex properties against meshoptimizer's `simplifyWithAttributes`:
+    /// one row per model with properties and share.
+    pub properties: Vec<PropertyRow>,
+}
+
+/// One model with properties at one share: ours and meshoptimizer's
+/// `simplifyWithAttributes` at the same triangle count.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PropertyRow {
+    pub model: String,
+    pub share: f64,
+    pub mts: PropertySide,
+    pub meshopt: PropertySide,
+}
+
+/// Geometric error (relative to the diagonal) and property error (UV
+/// units, degrees, RGBA distance; `null` for a stream the model lacks).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PropertySide {
+    pub triangles: u64,
+    pub hausdorff: f64,
+    pub rms: f64,
+    pub uv_rms: Option<f64>,
+    pub normal_degrees_rms: Option<f64>,
+    pub color_rms: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

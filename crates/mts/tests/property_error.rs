@@ -5,25 +5,15 @@
 mod common;
 
 use mts::distance::property_error;
-use mts::mesh::io::{load, LoadOptions};
 use mts::mesh::Mesh;
 use mts::{simplify, SimplifyOptions};
-
-fn with_properties(name: &str) -> Option<Mesh> {
-    let dir = common::models_dir()?;
-    let options = LoadOptions {
-        properties: true,
-        ..LoadOptions::default()
-    };
-    Some(load(&dir.join(name), options).unwrap().0)
-}
 
 #[test]
 fn a_model_against_itself_measures_zero() {
     // spot has UV seams; pirate has UV and normal seams and 217 positions
     // repeated by separate `v` lines where parts touch.
     for name in ["spot.obj", "pirate.obj"] {
-        let Some(mesh) = with_properties(name) else {
+        let Some(mesh) = common::model_with_properties(name) else {
             return;
         };
         let e = property_error(&mesh, &mesh.clone(), 20_000);
@@ -40,7 +30,7 @@ fn a_model_against_itself_measures_zero() {
 
 #[test]
 fn a_coarse_lod_of_spot_has_bounded_uv_error() {
-    let Some(mesh) = with_properties("spot.obj") else {
+    let Some(mesh) = common::model_with_properties("spot.obj") else {
         return;
     };
     let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
@@ -83,7 +73,7 @@ mod peers {
 
     #[test]
     fn uv_weights_lower_meshoptimizer_uv_error_on_spot() {
-        let Some(mesh) = with_properties("spot.obj") else {
+        let Some(mesh) = common::model_with_properties("spot.obj") else {
             return;
         };
         let c = super::simplify(&mesh, &SimplifyOptions::default()).collapses;

@@ -3,19 +3,9 @@
 
 mod common;
 
-use mts::mesh::io::{load, LoadOptions};
 use mts::mesh::Mesh;
 use mts::{simplify, SimplifyOptions};
 use std::collections::HashMap;
-
-fn with_properties(name: &str) -> Option<Mesh> {
-    let dir = common::models_dir()?;
-    let options = LoadOptions {
-        properties: true,
-        ..LoadOptions::default()
-    };
-    Some(load(&dir.join(name), options).unwrap().0)
-}
 
 /// Edges between points (not vertices) used by one triangle only, and the
 /// points that carry more than one vertex, of `mesh` at a LoD.
@@ -40,7 +30,7 @@ fn borders_and_seam_points(mesh: &Mesh) -> (usize, usize) {
 #[test]
 fn seams_stay_closed_and_never_multiply() {
     for name in ["spot.obj", "pirate.obj", "suzanne.obj", "beetle.obj"] {
-        let Some(mesh) = with_properties(name) else {
+        let Some(mesh) = common::model_with_properties(name) else {
             return;
         };
         let (borders0, seam_points0) = borders_and_seam_points(&mesh);
@@ -76,7 +66,7 @@ fn models_of_seamed_meshes_match_the_oracle_and_round_trip() {
     use mts::strip::sorted_canonical;
     use mts::{Extractor, MtsModel};
     for name in ["spot.obj", "pirate.obj"] {
-        let Some(mesh) = with_properties(name) else {
+        let Some(mesh) = common::model_with_properties(name) else {
             return;
         };
         let (model, _, _) = build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});

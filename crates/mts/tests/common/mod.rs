@@ -100,3 +100,14 @@ pub fn model(name: &str) -> Option<Mesh> {
     }
     Some(load(&path, LoadOptions::default()).unwrap().0)
 }
+
+/// [`model`] loaded with its properties (normals, texture coordinates,
+/// colours; vertices split at seams).
+pub fn model_with_properties(name: &str) -> Option<Mesh> {
+    let path = models_dir()?.join(name);
+    let options = LoadOptions {
+        properties: true,
+        ..LoadOptions::default()
+    };
+    Some(load(&path, options).unwrap().0)
+}

@@ -23,6 +23,10 @@ use super::*;
 use crate::mesh::Properties;
 use crate::simplify::AttributeWeights;
 
+/// Live vertices of a point that [`Attributes::cost`] looks at, on each
+/// side (real meshes have at most a handful per point).
+const MOST_VERTICES: usize = 16;
+
 /// One channel's quadric: `Σ w (g·p + d - s)²` expanded.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Channel {
@@ -218,17 +222,26 @@ impl Attributes {
     /// mean, over the triangles of `a`'s vertices, of each vertex's error
     /// at the vertex of `b` it fits best (the seam guard later fixes the
     /// pairing; the best fit is its usual outcome and a cheap estimate).
+    ///
+    /// Each side counts at most [`MOST_VERTICES`] live vertices, so that a
+    /// point split into thousands (a hostile file: every corner of one
+    /// position with its own texture coordinate) costs a bounded time per
+    /// evaluation instead of the square of its count.
     pub(super) fn cost(&self, a: u32, b: u32, p: DVec3) -> f64 {
         let (mut sum, mut weight) = (0.0, 0.0);
-        for &wa in self.vertices_of(a) {
-            if self.gone[wa as usize] || self.weight[wa as usize] == 0.0 {
+        let live = |point: u32| {
+            self.vertices_of(point)
+                .iter()
+                .copied()
+                .filter(|&w| !self.gone[w as usize])
+                .take(MOST_VERTICES)
+        };
+        for wa in live(a) {
+            if self.weight[wa as usize] == 0.0 {
                 continue;
             }
-            let best = self
-                .vertices_of(b)
-                .iter()
-                .filter(|&&wb| !self.gone[wb as usize])
-                .map(|&wb| self.error(wa, wb, p))
+            let best = live(b)
+                .map(|wb| self.error(wa, wb, p))
                 .fold(f64::INFINITY, f64::min);
             if best.is_finite() {
                 sum += best;

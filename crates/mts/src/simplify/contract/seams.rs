@@ -18,12 +18,20 @@
 //! - two vertices of `a` are paired with one of `b` (the two sides of the
 //!   seam would share `b`'s properties: a smear).
 //!
+//! - the point pairs more than [`MOST_PAIRS`] vertices (a hostile split).
+//!
 //! So a seam is simplified along itself, as a border is, and its points
 //! never multiply. Virtual pairs (no shared triangle) are refused on a
 //! seamed mesh. Each vertex keeps its input properties (endpoint
 //! placement), so a LoD change rewrites indices only.
 
 use super::*;
+
+/// A point whose vertices on the edges it would contract along are more
+/// than this stays where it is: real seams meet a handful of times at a
+/// point, and the pairing is found by linear search, so a hostile file
+/// splitting one point into thousands costs bounded time per check.
+const MOST_PAIRS: usize = 64;
 
 impl<P: Place> Contractor<P> {
     /// Pairs each vertex of `a` that live triangles use with the vertex of
@@ -49,7 +57,11 @@ impl<P: Place> Contractor<P> {
                 Some(&(_, y)) if y != wb => fine = false,
                 Some(_) => {}
                 None if map.iter().any(|&(_, y)| y == wb) => fine = false,
+                None if map.len() == MOST_PAIRS => fine = false,
                 None => map.push((wa, wb)),
+            }
+            if !fine {
+                break;
             }
         }
         if fine && !map.is_empty() {
