@@ -596,32 +596,8 @@ impl Reader<'_> {
         let texture = self.texture();
         let sources = &self.vertex_sources;
         let props = &mut self.raw.properties;
-        if sources.iter().any(|s| s.1 != NONE) {
-            props.uvs = Some(
-                sources
-                    .iter()
-                    .map(|s| {
-                        self.texcoords
-                            .get(s.1 as usize)
-                            .copied()
-                            .unwrap_or(Vec2::ZERO)
-                    })
-                    .collect(),
-            );
-        }
-        if sources.iter().any(|s| s.2 != NONE) {
-            props.normals = Some(
-                sources
-                    .iter()
-                    .map(|s| {
-                        self.normals
-                            .get(s.2 as usize)
-                            .copied()
-                            .unwrap_or(Vec3::ZERO)
-                    })
-                    .collect(),
-            );
-        }
+        props.uvs = per_vertex(sources.iter().map(|s| s.1), &self.texcoords);
+        props.normals = per_vertex(sources.iter().map(|s| s.2), &self.normals);
         if props.uvs.is_some() || props.normals.is_some() {
             props.position_ids = sources.iter().map(|s| s.0 as u32).collect();
         }
@@ -699,6 +675,22 @@ impl Reader<'_> {
         }
         Ok(())
     }
+}
+
+/// The values `indices` name, one per vertex (zero where a vertex names
+/// none), or `None` when no vertex names one.
+fn per_vertex<T: Copy + Default>(
+    indices: impl Iterator<Item = u64> + Clone,
+    values: &[T],
+) -> Option<Vec<T>> {
+    if indices.clone().all(|i| i == NONE) {
+        return None;
+    }
+    Some(
+        indices
+            .map(|i| values.get(i as usize).copied().unwrap_or_default())
+            .collect(),
+    )
 }
 
 /// The materials of `.mtl` text with their `map_Kd` file, if any (its
