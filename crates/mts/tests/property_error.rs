@@ -5,7 +5,6 @@
 mod common;
 
 use mts::distance::property_error;
-use mts::mesh::Mesh;
 use mts::{simplify, SimplifyOptions};
 
 #[test]
@@ -86,7 +85,7 @@ mod peers {
             let (theirs, at) = simplify_with_attributes_to_lod(&mesh, &c, lod, weights);
             // The LoD to compare with has at most their count.
             assert!(c.triangle_count(at) <= theirs.len().max(c.triangle_count(lod)));
-            let theirs = Mesh {
+            let theirs = mts::mesh::Mesh {
                 triangles: theirs,
                 ..mesh.clone()
             };
