@@ -265,7 +265,7 @@ impl Reader<'_> {
         match keyword {
             "v" => self.vertex(words, line, byte),
             "vt" => {
-                let values = numbers(words)
+                let (values, [u, v, ..]) = numbers(words)
                     .map_err(|w| self.error(line, byte, "vt", format!("`{w}` is not a number")))?;
                 if !(1..=3).contains(&values) {
                     return Err(self.error(
@@ -277,9 +277,7 @@ impl Reader<'_> {
                 }
                 self.texcoord_count += 1;
                 if self.properties {
-                    let mut w = text.split_whitespace().skip(1).map(|w| w.parse::<f32>());
-                    let u = w.next().and_then(|x| x.ok()).unwrap_or(0.0);
-                    let v = w.next().and_then(|x| x.ok()).unwrap_or(0.0);
+                    // `vt u` alone has v = 0, as the format says.
                     let t = Vec2::new(u, v);
                     if !t.is_finite() {
                         return Err(self.error(line, byte, "vt", "NaN or infinite".into()));
@@ -289,7 +287,7 @@ impl Reader<'_> {
                 Ok(())
             }
             "vn" => {
-                let values = numbers(words)
+                let (values, [x, y, z, _]) = numbers(words)
                     .map_err(|w| self.error(line, byte, "vn", format!("`{w}` is not a number")))?;
                 if values != 3 {
                     return Err(self.error(
@@ -301,11 +299,7 @@ impl Reader<'_> {
                 }
                 self.normal_count += 1;
                 if self.properties {
-                    let mut n = [0f32; 3];
-                    for (c, w) in n.iter_mut().zip(text.split_whitespace().skip(1)) {
-                        *c = w.parse().unwrap_or(f32::NAN);
-                    }
-                    let n = Vec3::from(n);
+                    let n = Vec3::new(x, y, z);
                     if !n.is_finite() {
                         return Err(self.error(line, byte, "vn", "NaN or infinite".into()));
                     }
@@ -714,13 +708,20 @@ fn materials(text: &str) -> Vec<(String, Option<String>)> {
 }
 
 /// How many of `words` there are, or the first that is not a number.
-fn numbers<'a>(words: impl Iterator<Item = &'a str>) -> std::result::Result<usize, &'a str> {
-    let mut n = 0;
+/// How many of `words` there are and the first four of their values, or
+/// the first that is not a number.
+fn numbers<'a>(
+    words: impl Iterator<Item = &'a str>,
+) -> std::result::Result<(usize, [f32; 4]), &'a str> {
+    let (mut n, mut values) = (0, [0.0; 4]);
     for w in words {
-        w.parse::<f32>().map_err(|_| w)?;
+        let x = w.parse::<f32>().map_err(|_| w)?;
+        if let Some(slot) = values.get_mut(n) {
+            *slot = x;
+        }
         n += 1;
     }
-    Ok(n)
+    Ok((n, values))
 }
 
 #[cfg(test)]
