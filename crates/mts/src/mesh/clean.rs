@@ -23,7 +23,9 @@ pub struct RawMesh {
     /// [`clean`]). `position_ids` here may be any numbers (e.g. the
     /// source's position index of each vertex): equal numbers say that
     /// vertices are one point split at a seam, and such vertices must have
-    /// identical positions.
+    /// identical positions. Empty with property streams (a source that
+    /// cannot say, such as PLY or glTF): vertices with bit-identical
+    /// positions are one point.
     pub properties: Properties,
 }
 
@@ -127,6 +129,21 @@ pub fn clean(
                     .or_insert(i as u32)
             })
             .collect()
+    } else if properties.position_ids.is_empty() && !properties.is_empty() {
+        // Property streams but no word on seams (PLY, glTF): vertices with
+        // bit-identical positions are one point, as meshoptimizer also
+        // assumes. Otherwise a seam would be two borders that
+        // simplification could pull apart; the cost is that two parts
+        // touching at exactly one position are joined there too.
+        let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(n);
+        for (i, p) in positions_in.iter().enumerate() {
+            point.push(
+                *first
+                    .entry(p.to_array().map(f32::to_bits))
+                    .or_insert(i as u32),
+            );
+        }
+        (0..n as u32).collect()
     } else {
         let mut first: HashMap<u32, u32> = HashMap::new();
         for i in 0..n as u32 {
@@ -382,6 +399,16 @@ mod tests {
         assert_eq!((report.welded, welded.vertex_count()), (2, 6));
         assert!(welded.properties.position_ids.is_empty());
         assert_eq!(welded.triangles[2], [1, 4, 5]);
+    }
+
+    /// Without position ids (PLY, glTF) equal positions are one point.
+    #[test]
+    fn streams_without_ids_make_equal_positions_one_point() {
+        let mut raw = seamed();
+        raw.properties.position_ids.clear();
+        let (mesh, report) = clean(raw, CleanOptions::default(), "t").unwrap();
+        assert_eq!((report.welded, mesh.vertex_count()), (0, 8));
+        assert_eq!(mesh.properties.position_ids, vec![0, 1, 2, 3, 1, 2, 4, 5]);
     }
 
     #[test]

@@ -215,28 +215,8 @@ pub fn load(path: &Path, options: LoadOptions) -> Result<(Mesh, CleanReport)> {
     };
     if !options.properties {
         raw.properties = crate::mesh::Properties::default();
-    } else if format != Format::Obj && !raw.properties.is_empty() {
-        raw.properties.position_ids = points_by_position(&raw.positions);
     }
     clean(raw, options.clean, &path.display().to_string())
-}
-
-/// The point of each vertex for formats that cannot say which vertices a
-/// seam split (PLY, glTF): vertices with bit-identical positions are one
-/// point, as meshoptimizer also assumes. Without it a seam would be two
-/// borders that simplification could pull apart; the cost is that two
-/// parts touching at exactly one position are joined there too.
-fn points_by_position(positions: &[glam::Vec3]) -> Vec<u32> {
-    let mut first = std::collections::HashMap::with_capacity(positions.len());
-    positions
-        .iter()
-        .enumerate()
-        .map(|(v, p)| {
-            *first
-                .entry(p.to_array().map(f32::to_bits))
-                .or_insert(v as u32)
-        })
-        .collect()
 }
 
 /// Writes `mesh` in the format its extension names: `.obj`
