@@ -230,19 +230,7 @@ type PositionKey = (u32, u32, u32);
 /// Checks the property counts and values a source gave, normalising
 /// normals and clamping colours.
 fn check_properties(p: &mut Properties, n: usize) -> std::result::Result<(), String> {
-    let count = |name: &str, len: Option<usize>| match len {
-        Some(len) if len != n => Err(format!("{len} {name} for {n} vertices")),
-        _ => Ok(()),
-    };
-    count("normals", p.normals.as_ref().map(Vec::len))?;
-    count("texture coordinates", p.uvs.as_ref().map(Vec::len))?;
-    count("colours", p.colors.as_ref().map(Vec::len))?;
-    if !p.position_ids.is_empty() && p.position_ids.len() != n {
-        return Err(format!(
-            "{} position ids for {n} vertices",
-            p.position_ids.len()
-        ));
-    }
+    p.check_counts(n)?;
     if let Some(normals) = &mut p.normals {
         for (v, x) in normals.iter_mut().enumerate() {
             if !x.is_finite() {

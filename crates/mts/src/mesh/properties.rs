@@ -116,13 +116,12 @@ impl Properties {
         }
     }
 
-    /// Checks the invariants listed on [`Properties`] for a mesh with
-    /// `positions`.
+    /// Checks that every stream, and the position ids when present, has
+    /// one entry per vertex of `n`.
     ///
     /// # Errors
-    /// The first broken invariant.
-    pub fn validate(&self, positions: &[Vec3]) -> Result<(), String> {
-        let n = positions.len();
+    /// The first stream of another length.
+    pub fn check_counts(&self, n: usize) -> Result<(), String> {
         let count = |name: &str, len: Option<usize>| match len {
             Some(len) if len != n => Err(format!("{len} {name} for {n} vertices")),
             _ => Ok(()),
@@ -130,6 +129,20 @@ impl Properties {
         count("normals", self.normals.as_ref().map(Vec::len))?;
         count("texture coordinates", self.uvs.as_ref().map(Vec::len))?;
         count("colours", self.colors.as_ref().map(Vec::len))?;
+        count(
+            "position ids",
+            (!self.position_ids.is_empty()).then_some(self.position_ids.len()),
+        )
+    }
+
+    /// Checks the invariants listed on [`Properties`] for a mesh with
+    /// `positions`.
+    ///
+    /// # Errors
+    /// The first broken invariant.
+    pub fn validate(&self, positions: &[Vec3]) -> Result<(), String> {
+        let n = positions.len();
+        self.check_counts(n)?;
         if let Some(normals) = &self.normals {
             for (v, n) in normals.iter().enumerate() {
                 let len2 = n.length_squared();
@@ -151,12 +164,6 @@ impl Properties {
             }
         }
         if !self.position_ids.is_empty() {
-            if self.position_ids.len() != n {
-                return Err(format!(
-                    "{} position ids for {n} vertices",
-                    self.position_ids.len()
-                ));
-            }
             let mut first: Vec<u32> = Vec::new();
             for (v, &id) in self.position_ids.iter().enumerate() {
                 let id = id as usize;

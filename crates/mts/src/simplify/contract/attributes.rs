@@ -23,7 +23,7 @@ use super::*;
 use crate::mesh::Properties;
 use crate::simplify::AttributeWeights;
 
-/// Live vertices of a point that [`Attributes::cost`] looks at, on each
+/// Vertices of a point that [`Attributes::cost`] looks at, on each
 /// side (real meshes have at most a handful per point).
 const MOST_VERTICES: usize = 16;
 
@@ -106,8 +106,6 @@ pub(super) struct Attributes {
     /// Vertices of each point: `point_vertices[point_start[p]..point_start[p + 1]]`.
     point_start: Vec<u32>,
     point_vertices: Vec<u32>,
-    /// Vertices moved onto another (their quadric went with them).
-    gone: Vec<bool>,
 }
 
 impl Attributes {
@@ -230,7 +228,6 @@ impl Attributes {
             weight,
             point_start,
             point_vertices,
-            gone: vec![false; n],
         })
     }
 
@@ -244,19 +241,15 @@ impl Attributes {
     /// at the vertex of `b` it fits best (the seam guard later fixes the
     /// pairing; the best fit is its usual outcome and a cheap estimate).
     ///
-    /// Each side counts at most [`MOST_VERTICES`] live vertices, so that a
+    /// `a` and `b` are live points, whose vertices are all live: a vertex
+    /// is only merged away with its point. Each side counts at most
+    /// [`MOST_VERTICES`] vertices, so that a
     /// point split into thousands (a hostile file: every corner of one
     /// position with its own texture coordinate) costs a bounded time per
     /// evaluation instead of the square of its count.
     pub(super) fn cost(&self, a: u32, b: u32, p: DVec3) -> f64 {
         let (mut sum, mut weight) = (0.0, 0.0);
-        let live = |point: u32| {
-            self.vertices_of(point)
-                .iter()
-                .copied()
-                .filter(|&w| !self.gone[w as usize])
-                .take(MOST_VERTICES)
-        };
+        let live = |point: u32| self.vertices_of(point).iter().copied().take(MOST_VERTICES);
         let k = self.k;
         let mut at = [0.0f64; MAX_CHANNELS];
         for wa in live(a) {
@@ -303,6 +296,5 @@ impl Attributes {
             to.1 += d;
         }
         self.weight[wb as usize] += self.weight[wa as usize];
-        self.gone[wa as usize] = true;
     }
 }
