@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 3;
+pub const SCHEMA_VERSION: u32 = 4;
 
 /// Shares of the full triangle count reported in Tables 3–4.
 const SHARES: [f64; 6] = mts::methods::SHARES;
@@ -149,7 +149,7 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
         Some(fast_simplification(&options.models)?)
     };
     progress("properties");
-    let properties = measure_properties(&options.models, options.quick)?;
+    let properties = measure_properties(&options.models, options.quick, &renderer)?;
     Ok(Results {
         schema: SCHEMA_VERSION,
         command: options.command.clone(),
@@ -171,8 +171,9 @@ fn property_table(s: &mut String, rows: &[PropertyRow]) {
         "\n## Vertex properties against meshoptimizer's `simplifyWithAttributes`\n"
     );
     let _ = writeln!(s, "Models loaded with `--properties` (UV and normal seams kept) and the generated `{PROPERTY_MESH}` with UVs, normals and colours; meshoptimizer's `simplifyWithAttributes` (normals 1, UV 30, colours 1) at the same triangle count. Geometric error relative to the diagonal; property error sampled like it at corresponding points, both directions pooled: UV distance, normal angle in degrees, RGBA distance (RMS; `docs/experiments/properties.md`).\n");
-    let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts / meshopt | RMS mts / meshopt | UV mts / meshopt | normal° mts / meshopt | colour mts / meshopt |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "Image: the LoD drawn with the model's properties (the checker texture where it has UVs, `mts render --checker`) from the fixed camera that frames it, against the full model drawn alike: share of the model's pixels whose colour moved by more than {} of 255, and the RMS RGB difference.\n", super::figure6::IMAGE_TOLERANCE);
+    let _ = writeln!(s, "| model | share | triangles (mts / meshopt) | Hausdorff mts / meshopt | RMS mts / meshopt | UV mts / meshopt | normal° mts / meshopt | colour mts / meshopt | image pixels changed mts / meshopt | image RMS mts / meshopt |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
     let pair = |a: Option<f64>, b: Option<f64>, digits: usize| match (a, b) {
         (Some(a), Some(b)) => format!("{a:.digits$} / {b:.digits$}"),
         _ => "—".to_string(),
@@ -181,7 +182,7 @@ fn property_table(s: &mut String, rows: &[PropertyRow]) {
         let (m, o) = (&r.mts, &r.meshopt);
         let _ = writeln!(
             s,
-            "| {} | {:.0}% | {} / {} | {:.5} / {:.5} | {:.5} / {:.5} | {} | {} | {} |",
+            "| {} | {:.0}% | {} / {} | {:.5} / {:.5} | {:.5} / {:.5} | {} | {} | {} | {} | {} |",
             r.model,
             r.share * 100.0,
             m.triangles,
@@ -193,6 +194,11 @@ fn property_table(s: &mut String, rows: &[PropertyRow]) {
             pair(m.uv_rms, o.uv_rms, 4),
             pair(m.normal_degrees_rms, o.normal_degrees_rms, 1),
             pair(m.color_rms, o.color_rms, 4),
+            match (m.image_differing_share, o.image_differing_share) {
+                (Some(a), Some(b)) => format!("{:.1}% / {:.1}%", 100.0 * a, 100.0 * b),
+                _ => "—".to_string(),
+            },
+            pair(m.image_rms, o.image_rms, 4),
         );
     }
 }
@@ -208,7 +214,11 @@ const PROPERTY_MESH: &str = "torus:20k";
 ///
 /// # Errors
 /// When a model cannot be loaded.
-fn measure_properties(models: &[PathBuf], quick: bool) -> Result<Vec<PropertyRow>> {
+fn measure_properties(
+    models: &[PathBuf],
+    quick: bool,
+    renderer: &Figure6,
+) -> Result<Vec<PropertyRow>> {
     use mts::distance::{property_error, surface_distance};
     use mts::peers::meshopt::{simplify_with_attributes_to_lod, AttributeWeights};
     let g: mts::mesh::generate::Generated = PROPERTY_MESH.parse().expect("a valid generated name");
@@ -242,12 +252,21 @@ fn measure_properties(models: &[PathBuf], quick: bool) -> Result<Vec<PropertyRow
                 c.lod_for_ratio(share),
                 AttributeWeights::default(),
             );
+            let ours_triangles = c.triangles_at(mesh, lod);
+            let images = match renderer {
+                Ok(r) => r
+                    .image_differences(mesh, &[&ours_triangles, &theirs])?
+                    .into_iter()
+                    .map(Some)
+                    .collect(),
+                Err(_) => vec![None, None],
+            };
             let ours = c.mesh_at(mesh, lod);
             let theirs = Mesh {
                 triangles: theirs,
                 ..mesh.clone()
             };
-            let side = |lod: &Mesh| {
+            let side = |lod: &Mesh, image: Option<mts_render::Difference>| {
                 let d = surface_distance(mesh.into(), lod.into(), SAMPLES);
                 let p = property_error(mesh, lod, SAMPLES);
                 PropertySide {
@@ -257,13 +276,15 @@ fn measure_properties(models: &[PathBuf], quick: bool) -> Result<Vec<PropertyRow
                     uv_rms: p.uv.map(|s| s.rms),
                     normal_degrees_rms: p.normal_degrees.map(|s| s.rms),
                     color_rms: p.color.map(|s| s.rms),
+                    image_differing_share: image.map(|i| i.share),
+                    image_rms: image.map(|i| i.rms),
                 }
             };
             rows.push(PropertyRow {
                 model: name.clone(),
                 share,
-                mts: side(&ours),
-                meshopt: side(&theirs),
+                mts: side(&ours, images[0]),
+                meshopt: side(&theirs, images[1]),
             });
         }
     }

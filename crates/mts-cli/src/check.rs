@@ -71,6 +71,20 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
                 && m.color_rms.is_some() == o.color_rms.is_some(),
             format!("{at}: a stream measured on one side only"),
         );
+        // The image difference wherever the run had an adapter.
+        let images = [
+            m.image_differing_share,
+            m.image_rms,
+            o.image_differing_share,
+            o.image_rms,
+        ];
+        need(
+            images
+                .iter()
+                .all(|i| i.is_some() == r.machine.adapter.is_some())
+                && images.iter().flatten().all(|&x| (0.0..=1.0).contains(&x)),
+            format!("{at}: an image difference missing or outside 0..=1"),
+        );
         let values = [m.hausdorff, m.rms, o.hausdorff, o.rms];
         let streams = [
             m.uv_rms,

@@ -34,6 +34,10 @@ use std::time::Instant;
 const WIDTH: u32 = 800;
 const HEIGHT: u32 = 600;
 
+/// Steps (of 255) an RGB byte may move before
+/// [`Renderer::image_differences`] counts the pixel as changed.
+pub const IMAGE_TOLERANCE: u8 = 8;
+
 /// The renderer state shared by every model of a run.
 pub struct Renderer {
     gpu: Gpu,
@@ -67,6 +71,45 @@ impl Renderer {
                 renderer.draw(pass)
             })?;
         Ok(t.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// How each triangle list of `lods` (over `input`'s vertices) looks
+    /// against `input` itself, both drawn with `input`'s properties (the
+    /// checker where it has UVs: `mts render --checker`) from the camera
+    /// that frames it: [`mts_render::Image::difference`] with tolerance
+    /// [`IMAGE_TOLERANCE`].
+    ///
+    /// # Errors
+    /// When the renderer cannot take the mesh or a frame cannot be read.
+    pub fn image_differences(
+        &self,
+        input: &mts::Mesh,
+        lods: &[&[[u32; 3]]],
+    ) -> Result<Vec<mts_render::Difference>> {
+        let (d, q) = (&self.gpu.device, &self.gpu.queue);
+        let appearance = mts_render::Appearance { checker: true };
+        let mut r = StripRenderer::with_properties(
+            d,
+            q,
+            &self.config,
+            &input.positions,
+            &input.triangles,
+            &input.properties,
+            &appearance,
+        )?;
+        r.set_camera(
+            q,
+            &Camera::framing_points(&input.positions, self.target.aspect()),
+        );
+        r.upload_list(d, q, &input.triangles)?;
+        let full = self.target.render_image(d, q, |pass| r.draw(pass))?;
+        let mut out = Vec::with_capacity(lods.len());
+        for triangles in lods {
+            r.upload_list(d, q, triangles)?;
+            let image = self.target.render_image(d, q, |pass| r.draw(pass))?;
+            out.push(full.difference(&image, IMAGE_TOLERANCE));
+        }
+        Ok(out)
     }
 
     /// Figure 6 rows of `model` (built from `input`) at `shares`, `frames`

@@ -52,6 +52,11 @@ pub struct PropertySide {
     pub uv_rms: Option<f64>,
     pub normal_degrees_rms: Option<f64>,
     pub color_rms: Option<f64>,
+    /// Against the full model drawn alike (checker where there are UVs,
+    /// fixed camera): share of the model's pixels that changed, and the
+    /// RMS RGB difference; `null` without an adapter.
+    pub image_differing_share: Option<f64>,
+    pub image_rms: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -54,6 +54,51 @@ impl Image {
             .count()
     }
 
+    /// How `other` differs from `self` (the reference) over the pixels
+    /// where either shows the model (differs from its own top-left pixel,
+    /// as [`Image::foreground_pixels`]): the share of them whose red, green
+    /// or blue byte differs by more than `tolerance`, and the RMS of the
+    /// RGB difference in 0..=1 sRGB units. The tolerance keeps shading
+    /// that moves by a step or two of rounding from counting as a changed
+    /// pixel while a checker square that moved (about 160 steps apart)
+    /// always does. Images of different sizes differ everywhere (share 1,
+    /// RMS 1). Cost: O(pixels).
+    #[must_use]
+    pub fn difference(&self, other: &Image, tolerance: u8) -> Difference {
+        if (self.width, self.height) != (other.width, other.height) {
+            return Difference {
+                pixels: (self.width * self.height).max(other.width * other.height) as usize,
+                share: 1.0,
+                rms: 1.0,
+            };
+        }
+        let (Some(ca), Some(cb)) = (self.rgba.get(..4), other.rgba.get(..4)) else {
+            return Difference::default();
+        };
+        let (mut pixels, mut differing, mut sum) = (0usize, 0usize, 0f64);
+        for (a, b) in self.rgba.chunks_exact(4).zip(other.rgba.chunks_exact(4)) {
+            if a == ca && b == cb {
+                continue;
+            }
+            pixels += 1;
+            let mut most = 0u8;
+            for c in 0..3 {
+                let d = a[c].abs_diff(b[c]);
+                most = most.max(d);
+                sum += (f64::from(d) / 255.0).powi(2);
+            }
+            differing += usize::from(most > tolerance);
+        }
+        if pixels == 0 {
+            return Difference::default();
+        }
+        Difference {
+            pixels,
+            share: differing as f64 / pixels as f64,
+            rms: (sum / (3 * pixels) as f64).sqrt(),
+        }
+    }
+
     /// Writes the image as an 8-bit RGBA PNG.
     ///
     /// # Errors
@@ -73,6 +118,17 @@ impl Image {
         writer.write_image_data(&self.rgba).map_err(png_error)?;
         writer.finish().map_err(png_error)
     }
+}
+
+/// [`Image::difference`]: how one image differs from a reference.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Difference {
+    /// Pixels where either image shows the model.
+    pub pixels: usize,
+    /// Share of those whose colour moved beyond the tolerance.
+    pub share: f64,
+    /// RMS of the RGB difference over those pixels, in 0..=1.
+    pub rms: f64,
 }
 
 /// A colour texture ([`COLOR_FORMAT`]) and depth texture ([`DEPTH_FORMAT`])
@@ -324,4 +380,50 @@ pub fn begin_cleared_pass<'e>(
         occlusion_query_set: None,
         multiview_mask: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4 × 1 image: background black in the corner, then `pixels`.
+    fn image(pixels: [[u8; 3]; 3]) -> Image {
+        let mut rgba = vec![0, 0, 0, 255];
+        for p in pixels {
+            rgba.extend_from_slice(&[p[0], p[1], p[2], 255]);
+        }
+        Image {
+            width: 4,
+            height: 1,
+            rgba,
+        }
+    }
+
+    #[test]
+    fn difference_counts_model_pixels_beyond_the_tolerance() {
+        let reference = image([[200, 200, 200], [64, 64, 64], [0, 0, 0]]);
+        // One pixel moved by 2 steps (within 8), one by 160, one newly
+        // covered; the corner is background in both.
+        let other = image([[202, 200, 200], [224, 64, 64], [10, 10, 10]]);
+        let d = reference.difference(&other, 8);
+        assert_eq!(d.pixels, 3);
+        assert!((d.share - 2.0 / 3.0).abs() < 1e-12, "{d:?}");
+        let sum = (2f64 / 255.0).powi(2) + (160f64 / 255.0).powi(2) + 3.0 * (10f64 / 255.0).powi(2);
+        assert!((d.rms - (sum / 9.0).sqrt()).abs() < 1e-12, "{d:?}");
+        // Its own black pixel is background: two pixels show the model.
+        assert_eq!(
+            reference.difference(&reference, 0),
+            Difference {
+                pixels: 2,
+                share: 0.0,
+                rms: 0.0
+            }
+        );
+        let other_size = Image {
+            width: 2,
+            height: 2,
+            rgba: vec![0; 16],
+        };
+        assert_eq!(reference.difference(&other_size, 8).share, 1.0);
+    }
 }

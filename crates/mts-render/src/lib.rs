@@ -28,7 +28,7 @@ pub mod texture;
 
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
-pub use headless::{HeadlessTarget, Image};
+pub use headless::{Difference, HeadlessTarget, Image};
 pub use scene::{FrameStats, InstanceId, InstancedScene, ModelId};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload, VERTEX_BYTES};
 pub use texture::Appearance;
