@@ -866,7 +866,9 @@ fn run(cli: &Cli) -> Result<()> {
 const PROGRESS_MIN_TRIANGLES: usize = 200_000;
 
 fn build(args: &BuildArgs) -> Result<()> {
+    let started = std::time::Instant::now();
     let (name, mesh, _) = args.source.load()?;
+    let load = started.elapsed();
     let options = args.pipeline_options();
     let (model, _, t) = build_with_bar(&mesh, &options);
     let bytes = model.to_bytes();
@@ -889,6 +891,7 @@ fn build(args: &BuildArgs) -> Result<()> {
                 "nodes": st.nodes,
                 "arcs": st.arcs,
                 "memory_bytes": st.memory_bytes,
+                "ms_load": ms(load),
                 "ms_stripify": ms(t.stripify),
                 "ms_simplify": ms(t.simplify),
                 "ms_model": ms(t.model),
@@ -903,7 +906,8 @@ fn build(args: &BuildArgs) -> Result<()> {
             model.max_lod() + 1
         );
         println!(
-            "  time      stripify {:.1} ms beside simplify {:.1} ms, model {:.1} ms, total {:.1} ms",
+            "  time      load {:.1} ms; stripify {:.1} ms beside simplify {:.1} ms, model {:.1} ms, total {:.1} ms",
+            ms(load),
             ms(t.stripify),
             ms(t.simplify),
             ms(t.model),
