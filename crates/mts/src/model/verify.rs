@@ -2,7 +2,11 @@
 //! (`../shared/DESIGN.md`, "The one invariant"): at each LoD the oriented
 //! triangles drawn from the extracted strips are exactly those of the naive
 //! replay of the contraction sequence, and coherent extraction is
-//! byte-identical to extraction from scratch.
+//! byte-identical to extraction from scratch. On a model with seams
+//! (position ids) it also checks that no contraction tears one: once a
+//! point is contracted away, none of its vertices is drawn (every one
+//! moved with it). Drawn vertices are input vertices, so the drawn
+//! triangles' properties are the oracle's whenever their indices are.
 //!
 //! Checking every LoD of a 70K-triangle model naively would cost
 //! O(LoDs × triangles) for the oracle alone. Both sides are kept
@@ -107,7 +111,11 @@ pub fn verify(model: &MtsModel, mesh: &Mesh, lods: &[usize]) -> VerifyReport {
         }
         scratch.set_lod_from_scratch(lod);
         let mut problem = None;
-        if tally.nonzero != 0 {
+        if let Some((step, w)) = oracle.torn {
+            problem = Some(format!(
+                "a seam is torn: contraction {step} moved its point without vertex {w}, still drawn"
+            ));
+        } else if tally.nonzero != 0 {
             problem = Some(format!(
                 "the strips draw {} oriented triangles in other numbers than the replay",
                 tally.nonzero
@@ -179,6 +187,14 @@ struct Oracle<'m> {
     lod: usize,
     current: Vec<[u32; 3]>,
     incident: Vec<Vec<u32>>,
+    /// On a model with seams: the vertices of each point (CSR over the
+    /// position ids), to see that a contraction leaves none of the removed
+    /// point's vertices drawn.
+    point_start: Vec<u32>,
+    point_vertices: Vec<u32>,
+    /// The first step that left a vertex of its removed point drawn (a
+    /// torn seam: that point's other vertices moved away), and the vertex.
+    torn: Option<(usize, u32)>,
 }
 
 impl<'m> Oracle<'m> {
@@ -196,11 +212,36 @@ impl<'m> Oracle<'m> {
                 incident[v as usize].push(i as u32);
             }
         }
+        let (point_start, point_vertices) = points(&model.properties().position_ids);
         Oracle {
             model,
             lod: 0,
             current: mesh.triangles.clone(),
             incident,
+            point_start,
+            point_vertices,
+            torn: None,
+        }
+    }
+
+    /// Whether a vertex of the point that step `step` removed is still
+    /// drawn after the step's moves: the seam was torn.
+    fn check_seam(&mut self, step: usize) {
+        let removed = self.model.collapses().steps()[step].removed as usize;
+        let Some(&point) = self.model.properties().position_ids.get(removed) else {
+            return;
+        };
+        let p = point as usize;
+        let vertices =
+            &self.point_vertices[self.point_start[p] as usize..self.point_start[p + 1] as usize];
+        for &w in vertices {
+            let drawn = self.incident[w as usize].iter().any(|&ti| {
+                let t = self.current[ti as usize];
+                !is_degenerate(t) && t.contains(&w)
+            });
+            if drawn && self.torn.is_none() {
+                self.torn = Some((step, w));
+            }
         }
     }
 
@@ -211,6 +252,9 @@ impl<'m> Oracle<'m> {
         while self.lod < lod {
             for (from, to) in collapses.moves(self.lod) {
                 self.move_vertex(from, to, tally);
+            }
+            if !self.point_vertices.is_empty() {
+                self.check_seam(self.lod);
             }
             self.lod += 1;
         }
@@ -240,6 +284,28 @@ impl<'m> Oracle<'m> {
         }
         self.incident[to as usize].extend(keep);
     }
+}
+
+/// The vertices of each point of `ids` (position ids; empty for a mesh
+/// without seams) as offsets and a list. O(vertices).
+fn points(ids: &[u32]) -> (Vec<u32>, Vec<u32>) {
+    let Some(&most) = ids.iter().max() else {
+        return (Vec::new(), Vec::new());
+    };
+    let mut start = vec![0u32; most as usize + 2];
+    for &p in ids {
+        start[p as usize + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut fill = start.clone();
+    let mut vertices = vec![0u32; ids.len()];
+    for (v, &p) in ids.iter().enumerate() {
+        vertices[fill[p as usize] as usize] = v as u32;
+        fill[p as usize] += 1;
+    }
+    (start, vertices)
 }
 
 #[cfg(test)]
@@ -284,6 +350,44 @@ mod tests {
         t.swap(0, 1);
         let report = verify(&model, &mesh, &[0]);
         assert_eq!(report.mismatches, 1);
+    }
+
+    #[test]
+    fn a_torn_seam_is_caught() {
+        let mesh = "torus:2k"
+            .parse::<Generated>()
+            .unwrap()
+            .build_with_properties();
+        let (mut model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
+        let report = verify(&model, &model.mesh(), &spread_lods(model.max_lod(), None));
+        assert_eq!(report.mismatches, 0, "{:?}", report.first_mismatch);
+        // Drop the first companion move: that step moves its point but
+        // leaves one of its vertices behind.
+        let c = &mut model.recipe.collapses;
+        let step = c
+            .companion_start
+            .windows(2)
+            .position(|w| w[1] > w[0])
+            .unwrap();
+        let first = c.companion_start[step] as usize;
+        c.companions.remove(first);
+        for s in &mut c.companion_start[step + 1..] {
+            *s -= 1;
+        }
+        let report = verify(&model, &model.mesh(), &spread_lods(model.max_lod(), None));
+        assert!(report.mismatches >= 1);
+        let (lod, what) = report.first_mismatch.unwrap();
+        assert_eq!(lod, step + 1, "{what}");
+        assert!(
+            what.contains(&format!("seam is torn: contraction {step} ")),
+            "{what}"
+        );
+    }
+
+    #[test]
+    fn points_list_each_point_s_vertices() {
+        assert_eq!(points(&[]), (vec![], vec![]));
+        assert_eq!(points(&[1, 0, 1, 2]), (vec![0, 1, 3, 4], vec![1, 0, 2, 3]));
     }
 
     #[test]
