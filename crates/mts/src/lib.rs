@@ -41,6 +41,7 @@ pub mod methods;
 pub mod model;
 #[cfg(feature = "peers")]
 pub mod peers;
+pub mod screen_error;
 pub mod simplify;
 pub mod strip;
 
@@ -48,5 +49,6 @@ pub use error::{Error, Invalid, Place, Result};
 pub use lod::{LodSource, Topology};
 pub use mesh::Mesh;
 pub use model::{Extractor, MtsModel};
+pub use screen_error::{lod_for_screen_error, Projection};
 pub use simplify::{simplify, Collapses, SimplifyOptions};
 pub use strip::{stripify, StripifyOptions, Strips};
