@@ -39,9 +39,25 @@ const SAMPLES: usize = 100_000;
 /// `--quick` uses fewer.
 const STAGE_REPEAT: usize = 7;
 const QUICK_STAGE_REPEAT: usize = 3;
-/// Instances of the scene row (Figure 6's adapter), and with `--quick`.
-const SCENE_INSTANCES: usize = 1000;
-const QUICK_SCENE_INSTANCES: usize = 250;
+/// Instances of the scene rows (Figure 6's adapter) and their pixel
+/// thresholds, and with `--quick`.
+const SCENE_INSTANCES: [usize; 3] = [1_000, 10_000, 100_000];
+const SCENE_THRESHOLDS: [f32; 3] = [0.5, 1.0, 2.0];
+const QUICK_SCENE_INSTANCES: [usize; 1] = [250];
+const QUICK_SCENE_THRESHOLDS: [f32; 1] = [1.0];
+/// Models of the scene, in this order where measured (then the others),
+/// at most [`SCENE_MODELS`].
+const SCENE_PREFERRED: [&str; 8] = [
+    "bunny.ply",
+    "armadillo.obj",
+    "spot.obj",
+    "cow.obj",
+    "teapot.obj",
+    "fandisk.obj",
+    "homer.obj",
+    "rocker_arm.obj",
+];
+const SCENE_MODELS: usize = 8;
 
 /// What to measure.
 pub struct BenchOptions {
@@ -119,22 +135,28 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
     } else {
         STAGE_REPEAT
     };
-    // The scene row's model: the bunny when measured, else the first one.
-    let scene_name = inputs
+    // The scene's models: the preferred ones measured, then the others.
+    let mut scene_names: Vec<&String> = SCENE_PREFERRED
         .iter()
-        .map(|(n, _)| n)
-        .find(|n| *n == "bunny.ply")
-        .or(inputs.first().map(|(n, _)| n))
-        .cloned();
-    let mut scene = None;
+        .filter_map(|p| inputs.iter().map(|(n, _)| n).find(|n| n == p))
+        .collect();
+    for (n, _) in &inputs {
+        if !scene_names.contains(&n) {
+            scene_names.push(n);
+        }
+    }
+    scene_names.truncate(SCENE_MODELS);
+    let mut scene_models = Vec::new();
     for (name, mesh) in &inputs {
         progress(name);
         let (row, model) = measure_model(name, mesh, requests, repeat, &renderer, shares, frames)?;
         models.push(row);
-        if scene_name.as_ref() == Some(name) {
-            scene = measure_scene(name, &model, options.quick, frames, &renderer, progress)?;
+        if scene_names.contains(&name) {
+            scene_models.push((name.clone(), model));
         }
     }
+    let scenes = measure_scenes(&scene_models, options.quick, frames, &renderer, progress)?;
+    drop(scene_models);
     let scale = if options.quick {
         None
     } else {
@@ -159,9 +181,47 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
         models,
         scale,
         fast_simplification,
-        scene,
+        scenes,
         properties,
     })
+}
+
+/// The report's section on the scene.
+fn scene_table(s: &mut String, rows: &[Scene]) {
+    let Some(first) = rows.first() else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "\n## Scene: many instances of several models, LoD by screen-space error, shared buffers\n"
+    );
+    let _ = writeln!(s, "`mts bench render --scene`'s rows on Figure 6's adapter: instances of {} ({}) scaled to one radius on a ground plane, {}×{} pixels, a camera flying through the field ({} frames). Each visible instance gets the coarsest LoD whose recorded error projects within the threshold, and draws the shared buffer of its LoD bucket (10% fewer triangles a bucket), one instanced draw per (model, bucket). Update: cull, LoD choice, extractions, uploads; frame: update and draw. GPU: peak bucket buffers and transforms, against the sum of the models' full-detail strip buffers. Image: pixels covered by instances that differ at all from the same frame at full detail ({} frames of the path).\n", first.models, first.model_names.join(", "), first.width, first.height, first.frames, first.compared_frames);
+    let _ = writeln!(s, "| instances | px | visible | triangles (share of full) | draws | extractions / frame | update ms median / p99 | frame ms | CPU B / instance | GPU MB (× full strips) | buffers | pixels differing (by > {}/255) |", super::figure6::IMAGE_TOLERANCE);
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.0} | {:.0} ({:.1}%) | {:.1} | {:.2} | {:.2} / {:.2} | {:.1} | {} | {:.2} ({:.2}×) | {} | {} ({}) |",
+            r.instances,
+            r.pixel_threshold,
+            r.visible,
+            r.triangles_drawn,
+            100.0 * r.triangles_drawn / r.triangles_full_detail.max(1.0),
+            r.draws,
+            r.extractions_per_frame,
+            r.update_ms_median,
+            r.update_ms_p99,
+            r.frame_ms_median,
+            r.cpu_bytes_per_instance,
+            r.gpu_bytes as f64 / 1e6,
+            r.gpu_bytes as f64 / r.full_detail_strip_bytes.max(1) as f64,
+            r.buffers,
+            r.differing_pixel_share
+                .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
+            r.visibly_differing_pixel_share
+                .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
+        );
+    }
 }
 
 /// The report's section on vertex properties.
@@ -403,32 +463,45 @@ fn time_us(repeat: usize, mut f: impl FnMut()) -> f64 {
     )
 }
 
-/// The scene row: [`SCENE_INSTANCES`] instances (fewer with `--quick`) of
-/// `model` on Figure 6's adapter; `None` without one, or where the scene
-/// would refuse that many instances.
-fn measure_scene(
-    name: &str,
-    model: &MtsModel,
+/// The scene rows: [`SCENE_INSTANCES`] instances of `models` at each of
+/// [`SCENE_THRESHOLDS`] (fewer with `--quick`) on Figure 6's adapter,
+/// `frames` frames along the camera path; none without an adapter.
+///
+/// # Errors
+/// As [`super::bench_render::scene_row`].
+fn measure_scenes(
+    models: &[(String, MtsModel)],
     quick: bool,
     frames: usize,
     renderer: &Figure6,
     progress: &dyn Fn(&str),
-) -> Result<Option<Scene>> {
-    let instances = if quick {
-        QUICK_SCENE_INSTANCES
+) -> Result<Vec<Scene>> {
+    let (counts, thresholds): (&[usize], &[f32]) = if quick {
+        (&QUICK_SCENE_INSTANCES, &QUICK_SCENE_THRESHOLDS)
     } else {
-        SCENE_INSTANCES
+        (&SCENE_INSTANCES, &SCENE_THRESHOLDS)
     };
-    match renderer {
-        Ok(r) => {
-            progress(&format!("scene of {instances} × {name}"));
-            r.measure_scene(name, model, instances, frames)
-        }
-        Err(_) => {
-            let _ = (name, model, instances, frames, progress);
-            Ok(None)
+    let (Ok(r), false) = (renderer, models.is_empty()) else {
+        return Ok(Vec::new());
+    };
+    let refs: Vec<(String, &MtsModel)> = models.iter().map(|(n, m)| (n.clone(), m)).collect();
+    let mut rows = Vec::new();
+    for &instances in counts {
+        for &pixel_error in thresholds {
+            progress(&format!(
+                "scene of {instances} instances of {} models at {pixel_error} px",
+                models.len()
+            ));
+            let spec = super::bench_render::SceneSpec {
+                instances,
+                pixel_error,
+                frames,
+                compared_frames: super::bench_render::SCENE_COMPARED_FRAMES,
+            };
+            rows.push(r.measure_scene(&refs, &spec)?);
         }
     }
+    Ok(rows)
 }
 
 /// Medians of `repeat` interleaved runs of `a` and `b` (so that a drift of
@@ -1117,26 +1190,7 @@ pub fn report(results: &Results) -> String {
             }
         }
     }
-    if let Some(scene) = &results.scene {
-        let _ = writeln!(s, "\n## Scene: many instances, each with its own LoD\n");
-        let _ = writeln!(s, "`mts bench render`'s scene row on Figure 6's adapter: instances on a ground plane seen by the overview camera, culled by the instance BVH, each given the finest LoD with at most one triangle per 4 projected pixels and its own coherence cache. Frame: every instance's update and the draw, median.\n");
-        let _ = writeln!(s, "| model | instances | visible | triangles | indices sent | CPU bytes per instance | first update ms | ms per frame | fps | Mtri/s |");
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.2} |",
-            scene.model,
-            scene.instances,
-            scene.visible,
-            scene.triangles,
-            scene.indices_sent,
-            scene.cpu_bytes_per_instance,
-            scene.ms_first_update,
-            scene.ms_per_frame,
-            scene.fps,
-            scene.triangles_per_second / 1e6,
-        );
-    }
+    scene_table(&mut s, &results.scenes);
     if let Some(scale) = &results.scale {
         let _ = writeln!(s, "\n## Scale: generated icospheres\n");
         scale_table(&mut s, scale);

@@ -26,19 +26,23 @@ pub struct BenchRenderArgs {
     /// Image size in pixels.
     #[arg(long, default_value = "1024x768")]
     size: Size,
-    /// Instances of the model in the scene row (0 to skip it; at most
-    /// 2^20).
+    /// Instances in the scene row, the models taken in turn (0 to skip
+    /// it; at most 2^22).
     #[arg(long, default_value_t = 1000, allow_negative_numbers = true,
-          value_parser = crate::count_in::<0, { 1 << 20 }>)]
+          value_parser = crate::count_in::<0, { 1 << 22 }>)]
     scene: usize,
+    /// More models for the scene (OBJ/PLY meshes; the first is the
+    /// command's model).
+    #[arg(long, value_name = "MESH", num_args = 1..)]
+    scene_with: Vec<std::path::PathBuf>,
+    /// The scene's screen-space error allowed, in pixels.
+    #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR,
+          value_parser = crate::pixel_error)]
+    pixel_error: f32,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
 }
-
-/// The scene row skips (with a note) where the scene itself would refuse:
-/// past this many bytes of per-instance coherence caches.
-use mts_render::scene::MAX_CACHE_BYTES as SCENE_MEMORY_CAP;
 
 /// What `--json` prints.
 #[derive(Serialize)]
@@ -180,7 +184,19 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
         }
     }
     let scene = if args.scene > 0 {
-        bench_scene(&gpu, &target, &config, &name, &model, args)?
+        let others = args
+            .scene_with
+            .iter()
+            .map(|p| {
+                let (mesh, _) = mts::mesh::io::load(p, Default::default())?;
+                let (m, _, _) =
+                    mts::model::build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});
+                Ok((p.display().to_string(), m))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut models = vec![(name.clone(), &model)];
+        models.extend(others.iter().map(|(n, m)| (n.clone(), m)));
+        Some(bench_scene(&gpu, &target, &config, &models, args)?)
     } else {
         None
     };
@@ -204,90 +220,187 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// Median frame (update and draw) of `args.scene` instances seen by the
-/// scene's overview camera; prints a row unless `--json`. `None` (with a
-/// note on stderr) when the instances' coherence caches would exceed
-/// [`SCENE_MEMORY_CAP`].
+/// The scene rows of `mts bench render --scene N`: [`scene_row`] over the
+/// command's model and `--scene-with` models; prints them unless `--json`.
 fn bench_scene(
     gpu: &Gpu,
     target: &HeadlessTarget,
     config: &RendererConfig,
-    name: &str,
-    model: &mts::MtsModel,
+    models: &[(String, &mts::MtsModel)],
     args: &BenchRenderArgs,
-) -> Result<Option<Scene>> {
-    let row = scene_row(gpu, target, config, name, model, args.scene, args.frames)?;
-    if let (Some(r), false) = (&row, args.json) {
-        let ms = r.ms_per_frame;
-        println!(
-            "scene: {} instances, {} visible, {} triangles, {} indices sent; \
-             first update {:.1} ms; frame {ms:.2} ms = {:.1} fps, {:.2} Mtri/s",
-            args.scene,
-            r.visible,
-            r.triangles,
-            r.indices_sent,
-            r.ms_first_update,
-            1e3 / ms,
-            r.triangles_per_second / 1e6,
-        );
+) -> Result<Scene> {
+    let spec = SceneSpec {
+        instances: args.scene,
+        pixel_error: args.pixel_error,
+        frames: args.frames,
+        compared_frames: SCENE_COMPARED_FRAMES,
+    };
+    let row = scene_row(gpu, target, config, models, &spec)?;
+    if !args.json {
+        print_scene(&row);
     }
     Ok(row)
 }
 
-/// Median frame (every instance's LoD update and the draw) of `instances`
-/// copies of `model` (called `name`) seen by the scene's overview camera,
-/// `frames` timed frames after two warm-up ones. `None` (with a note on
-/// stderr) when the instances' coherence caches would exceed
-/// [`SCENE_MEMORY_CAP`].
+/// One scene row as text.
+pub fn print_scene(r: &Scene) {
+    println!(
+        "scene: {} instances of {} models at {} px: {:.0} visible, {:.0} of {:.0} triangles \
+         ({:.1}%), {:.1} draws, {:.2} extractions a frame; update {:.2} ms median, {:.2} ms p99; \
+         frame {:.2} ms; {} B CPU per instance, GPU {:.1} MB ({:.2} x the full-detail strips) \
+         in {} buffers; {} of the covered pixels differ from full detail ({} by more than {} \
+         of 255)",
+        r.instances,
+        r.models,
+        r.pixel_threshold,
+        r.visible,
+        r.triangles_drawn,
+        r.triangles_full_detail,
+        100.0 * r.triangles_drawn / r.triangles_full_detail.max(1.0),
+        r.draws,
+        r.extractions_per_frame,
+        r.update_ms_median,
+        r.update_ms_p99,
+        r.frame_ms_median,
+        r.cpu_bytes_per_instance,
+        r.gpu_bytes as f64 / 1e6,
+        r.gpu_bytes as f64 / r.full_detail_strip_bytes.max(1) as f64,
+        r.buffers,
+        r.differing_pixel_share
+            .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
+        r.visibly_differing_pixel_share
+            .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
+        crate::figure6::IMAGE_TOLERANCE,
+    );
+}
+
+/// Frames of the path compared with full detail by `mts bench render`.
+pub const SCENE_COMPARED_FRAMES: usize = 3;
+
+/// What a scene row measures.
+pub struct SceneSpec {
+    /// Instances (the models taken in turn).
+    pub instances: usize,
+    /// The screen-space error allowed, in pixels.
+    pub pixel_error: f32,
+    /// Frames along the camera path (timed).
+    pub frames: usize,
+    /// Frames of the path drawn also at full detail and compared (0 for
+    /// none: full detail costs the full triangle count per instance).
+    pub compared_frames: usize,
+}
+
+/// `spec.instances` instances of `models` (the demo layout) seen along the
+/// fly-through path: one untimed frame at its start, then `spec.frames`
+/// frames along it, each an update (cull, LoD choice, extractions,
+/// uploads) and a draw, timed apart; memory at its peak; and on
+/// `spec.compared_frames` frames spread along the path the image of the
+/// instances (no ground) against the same frame at full detail: the share
+/// of the pixels either covers whose colour differs at all.
+///
+/// # Errors
+/// As the scene's construction, update and drawing.
 pub fn scene_row(
     gpu: &Gpu,
     target: &HeadlessTarget,
     config: &RendererConfig,
-    name: &str,
-    model: &mts::MtsModel,
-    instances: usize,
-    frames: usize,
-) -> Result<Option<Scene>> {
+    models: &[(String, &mts::MtsModel)],
+    spec: &SceneSpec,
+) -> Result<Scene> {
     use crate::demo_scene::DemoScene;
-    let per_instance = 4 * Extractor::new(model).buffer().len();
-    if per_instance.saturating_mul(instances) > SCENE_MEMORY_CAP {
-        eprintln!(
-            "scene skipped: {instances} instances would hold {:.1} GB of coherence caches \
-             ({per_instance} bytes each); pass a smaller --scene",
-            (per_instance * instances) as f64 / 1e9,
-        );
-        return Ok(None);
-    }
-    let mut scene = DemoScene::new(&gpu.device, &gpu.queue, config, model, instances)?;
-    let camera = scene.overview_camera(target.aspect());
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let refs: Vec<&mts::MtsModel> = models.iter().map(|(_, m)| *m).collect();
+    let mut scene = DemoScene::new(d, q, config, &refs, spec.instances)?;
     let (width, height) = target.size();
-    let t = Instant::now();
-    let first = scene.update(&gpu.device, &gpu.queue, &camera, height as f32)?;
-    let first_ms = t.elapsed().as_secs_f64() * 1e3;
-    let mut times = Vec::with_capacity(frames);
-    let mut stats = first;
-    for i in 0..frames.max(1) + 2 {
+    let (aspect, h) = (target.aspect(), height as f32);
+    let frames = spec.frames.max(1);
+    let at = |i: usize| i as f32 / (frames.max(2) - 1) as f32;
+    scene.update(d, q, &scene.path_camera(0.0, aspect), h, spec.pixel_error)?;
+    target.render(d, q, |pass| scene.draw(pass))?;
+    let (mut update, mut frame) = (Vec::with_capacity(frames), Vec::with_capacity(frames));
+    let mut sums = [0f64; 6];
+    let (mut buffers, mut gpu_bytes, mut extractions_max) = (0, 0, 0);
+    for i in 0..frames {
+        let camera = scene.path_camera(at(i), aspect);
         let t = Instant::now();
-        stats = scene.update(&gpu.device, &gpu.queue, &camera, height as f32)?;
-        target.render(&gpu.device, &gpu.queue, |pass| scene.draw(pass))?;
-        if i >= 2 {
-            times.push(t.elapsed().as_secs_f64() * 1e3);
+        let stats = scene.update(d, q, &camera, h, spec.pixel_error)?;
+        update.push(t.elapsed().as_secs_f64() * 1e3);
+        target.render(d, q, |pass| scene.draw(pass))?;
+        frame.push(t.elapsed().as_secs_f64() * 1e3);
+        let memory = scene.scene.memory();
+        buffers = buffers.max(memory.buffers);
+        gpu_bytes = gpu_bytes.max(memory.gpu_bytes());
+        extractions_max = extractions_max.max(stats.extractions);
+        for (sum, x) in sums.iter_mut().zip([
+            stats.visible,
+            stats.triangles,
+            stats.triangles_full_detail,
+            stats.indices_drawn,
+            stats.draws,
+            stats.extractions,
+        ]) {
+            *sum += x as f64;
         }
     }
-    times.sort_by(f64::total_cmp);
-    let ms = times[times.len() / 2];
-    Ok(Some(Scene {
-        model: name.to_string(),
-        instances: instances as u64,
+    let memory = scene.scene.memory();
+    let mean = |x: f64| x / frames as f64;
+    let percentile = |mut v: Vec<f64>, p: f64| {
+        v.sort_by(f64::total_cmp);
+        v[((v.len() - 1) as f64 * p).round() as usize]
+    };
+    // Full detail on a few frames of the path, instances only.
+    let (mut differing, mut visibly, mut covered) = (0f64, 0f64, 0f64);
+    for k in 0..spec.compared_frames {
+        let camera = scene.path_camera((k as f32 + 0.5) / spec.compared_frames as f32, aspect);
+        scene.update(d, q, &camera, h, spec.pixel_error)?;
+        let lod = target.render_image(d, q, |pass| scene.scene.draw(pass))?;
+        scene.update(d, q, &camera, h, 0.0)?;
+        let full = target.render_image(d, q, |pass| scene.scene.draw(pass))?;
+        let diff = full.difference(&lod, 0);
+        differing += diff.share * diff.pixels as f64;
+        covered += diff.pixels as f64;
+        let visible = full.difference(&lod, crate::figure6::IMAGE_TOLERANCE);
+        visibly += visible.share * visible.pixels as f64;
+    }
+    let full_detail_strip_bytes = models
+        .iter()
+        .map(|(_, m)| {
+            let mut ex = Extractor::new(m);
+            ex.set_lod(0);
+            let bytes = if m.positions().len() <= usize::from(u16::MAX) {
+                2
+            } else {
+                4
+            };
+            bytes * ex.indices_sent() as u64
+        })
+        .sum();
+    Ok(Scene {
+        models: models.len() as u64,
+        model_names: models.iter().map(|(n, _)| n.clone()).collect(),
+        instances: spec.instances as u64,
         width,
         height,
-        visible: stats.visible as u64,
-        triangles: stats.triangles as u64,
-        indices_sent: stats.indices_sent as u64,
-        cpu_bytes_per_instance: per_instance as u64,
-        ms_first_update: first_ms,
-        ms_per_frame: ms,
-        fps: 1e3 / ms,
-        triangles_per_second: stats.triangles as f64 * 1e3 / ms,
-    }))
+        pixel_threshold: f64::from(spec.pixel_error),
+        frames: frames as u64,
+        visible: mean(sums[0]),
+        triangles_drawn: mean(sums[1]),
+        triangles_full_detail: mean(sums[2]),
+        indices_drawn: mean(sums[3]),
+        draws: mean(sums[4]),
+        extractions_per_frame: mean(sums[5]),
+        extractions_max: extractions_max as u64,
+        cpu_bytes_per_instance: memory.cpu_bytes_per_instance() as u64,
+        cpu_shared_bytes: memory.cpu_shared_bytes as u64,
+        gpu_bytes: gpu_bytes as u64,
+        gpu_vertex_bytes: memory.gpu_vertex_bytes as u64,
+        full_detail_strip_bytes,
+        buffers: buffers as u64,
+        update_ms_median: percentile(update.clone(), 0.5),
+        update_ms_p99: percentile(update, 0.99),
+        frame_ms_median: percentile(frame, 0.5),
+        compared_frames: spec.compared_frames as u64,
+        differing_pixel_share: (covered > 0.0).then(|| differing / covered),
+        visibly_differing_pixel_share: (covered > 0.0).then(|| visibly / covered),
+    })
 }

@@ -200,23 +200,51 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
         }
     }
     if r.machine.adapter.is_some() {
-        match &r.scene {
-            Some(sc) => {
-                if quick {
-                    need(
-                        sc.instances == 250,
-                        format!("scene of {} instances, not 250", sc.instances),
-                    );
-                }
-                need(
-                    0 < sc.visible && sc.visible <= sc.instances && sc.ms_per_frame > 0.0,
-                    format!(
-                        "scene: {} of {} visible, {} ms",
-                        sc.visible, sc.instances, sc.ms_per_frame
-                    ),
-                );
-            }
-            None => need(false, "an adapter ran but no scene".into()),
+        let counts: &[u64] = if quick {
+            &[250]
+        } else {
+            &[1_000, 10_000, 100_000]
+        };
+        let thresholds: &[f64] = if quick { &[1.0] } else { &[0.5, 1.0, 2.0] };
+        need(
+            r.scenes.len() == counts.len() * thresholds.len(),
+            format!(
+                "{} scene rows, not {}",
+                r.scenes.len(),
+                counts.len() * thresholds.len()
+            ),
+        );
+        for (i, sc) in r.scenes.iter().enumerate() {
+            let (n, px) = (
+                counts[(i / thresholds.len()).min(counts.len() - 1)],
+                thresholds[i % thresholds.len()],
+            );
+            need(
+                sc.instances == n && sc.pixel_threshold == px,
+                format!(
+                    "scene row {i}: {} instances at {} px, not {n} at {px}",
+                    sc.instances, sc.pixel_threshold
+                ),
+            );
+            need(
+                sc.visible > 0.0
+                    && sc.visible <= sc.instances as f64
+                    && sc.triangles_drawn <= sc.triangles_full_detail
+                    && sc.frame_ms_median > 0.0
+                    && sc.update_ms_p99 >= sc.update_ms_median
+                    && sc
+                        .differing_pixel_share
+                        .is_some_and(|x| (0.0..=1.0).contains(&x)),
+                format!(
+                    "scene row {i}: {} of {} visible, {} of {} triangles, {} ms, share {:?}",
+                    sc.visible,
+                    sc.instances,
+                    sc.triangles_drawn,
+                    sc.triangles_full_detail,
+                    sc.frame_ms_median,
+                    sc.differing_pixel_share
+                ),
+            );
         }
     }
     bad

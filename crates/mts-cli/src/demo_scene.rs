@@ -1,23 +1,24 @@
 //! The demo layout of `mts render --scene`, `mts view --scene` and the
-//! bench's scene row: `count` instances of one model on a square grid on a
-//! ground plane, and a camera above one corner looking across the field.
-//! The renderer's [`InstancedScene`] knows nothing of it: a host places its
-//! own instances.
+//! bench's scene rows: `count` instances of one or more models on a square
+//! grid on a ground plane, and two cameras: one above a corner looking
+//! across the field, and a path that flies through it. The renderer's
+//! [`InstancedScene`] knows nothing of it: a host places its own
+//! instances.
 
 use glam::{Mat4, Vec3};
 use mts::{MtsModel, Result};
-use mts_render::{
-    Camera, FrameStats, InstanceId, InstancedScene, ModelId, RendererConfig, StripRenderer,
-};
+use mts_render::{Camera, FrameStats, InstanceId, InstancedScene, RendererConfig, StripRenderer};
 
 /// Linear RGB of the ground plane (a muted green-grey, apart from the
 /// models' colour).
 pub const GROUND_COLOUR: Vec3 = Vec3::new(0.22, 0.27, 0.22);
 
-/// `count` instances of one model on a ground plane.
+/// Grid spacing in model radii (every instance is scaled to radius 1).
+const SPACING: f32 = 5.0;
+
+/// `count` instances of some models on a ground plane.
 pub struct DemoScene<'m> {
     pub scene: InstancedScene<'m>,
-    pub model: ModelId,
     pub instances: Vec<InstanceId>,
     ground: StripRenderer,
     /// Extent of the field: min and max corner on the ground.
@@ -25,42 +26,52 @@ pub struct DemoScene<'m> {
 }
 
 impl<'m> DemoScene<'m> {
-    /// Places `count` instances of `model` on a square grid on the plane
-    /// y = 0 (each resting on it, turned about +y by a fixed pseudo-random
-    /// angle), spaced 2.5 model diameters apart, with a ground quad under
-    /// them.
+    /// Places `count` instances of `models` (taken in turn) on a square
+    /// grid on the plane y = 0, each scaled to a bounding radius of 1,
+    /// resting on the plane and turned about +y by a fixed pseudo-random
+    /// angle, [`SPACING`] radii apart, with a ground quad under them.
     ///
     /// # Errors
-    /// As [`InstancedScene::add_model`] and [`InstancedScene::add_instance`].
+    /// As [`InstancedScene::add_model`] and [`InstancedScene::add_instance`];
+    /// no models or no instances.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         config: &RendererConfig,
-        model: &'m MtsModel,
+        models: &[&'m MtsModel],
         count: usize,
     ) -> Result<DemoScene<'m>> {
-        if count == 0 {
+        if count == 0 || models.is_empty() {
             return Err(mts::Error::InvalidArgument(
-                "a scene needs instances".into(),
+                "a scene needs models and instances".into(),
             ));
         }
         let mut scene = InstancedScene::new(config);
-        let id = scene.add_model(device, queue, model)?;
-        let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
-        let radius = ((mts::mesh::diagonal_of(min, max) * 0.5) as f32).max(f32::MIN_POSITIVE);
-        let spacing = 5.0 * radius;
+        // Per model: its id, its scale to radius 1, and the lift that
+        // rests its lowest point on the plane.
+        let mut placed = Vec::with_capacity(models.len());
+        for model in models {
+            let id = scene.add_model(device, queue, model)?;
+            let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
+            let radius = ((mts::mesh::diagonal_of(min, max) * 0.5) as f32).max(f32::MIN_POSITIVE);
+            let centre = (min + max) * 0.5;
+            placed.push((id, 1.0 / radius, centre, min.y));
+        }
         let side = (count as f64).sqrt().ceil() as usize;
         let mut instances = Vec::with_capacity(count);
         for i in 0..count {
+            let (id, scale, centre, low) = placed[i % placed.len()];
             let (gx, gz) = ((i % side) as f32, (i / side) as f32);
             let angle = std::f32::consts::TAU * hash01(i as u32);
-            // Rest on the plane: the lowest point of the box at y = 0.
-            let at = Vec3::new(gx * spacing, -min.y, gz * spacing);
-            let transform = Mat4::from_translation(at) * Mat4::from_rotation_y(angle);
+            let at = Vec3::new(gx * SPACING, (centre.y - low) * scale, gz * SPACING);
+            let transform = Mat4::from_translation(at)
+                * Mat4::from_rotation_y(angle)
+                * Mat4::from_scale(Vec3::splat(scale))
+                * Mat4::from_translation(-centre);
             instances.push(scene.add_instance(id, transform)?);
         }
-        let far = (side.max(1) - 1) as f32 * spacing;
-        let margin = 1.5 * spacing;
+        let far = (side.max(1) - 1) as f32 * SPACING;
+        let margin = 1.5 * SPACING;
         let field = (
             Vec3::new(-margin, 0.0, -margin),
             Vec3::new(far + margin, 0.0, far + margin),
@@ -80,7 +91,6 @@ impl<'m> DemoScene<'m> {
         ground.set_colour(GROUND_COLOUR);
         Ok(DemoScene {
             scene,
-            model: id,
             instances,
             ground,
             field,
@@ -99,6 +109,24 @@ impl<'m> DemoScene<'m> {
         Camera::looking(eye, target, aspect, 0.01 * size, 2.0 * size)
     }
 
+    /// The camera `t` (0 to 1) of the way along the fly-through: from the
+    /// field's corner towards its centre, three radii above the ground
+    /// (just over the instances), weaving gently and looking ahead and a
+    /// little down, so that instances pass from the far distance to right
+    /// beside the eye. The path has the same shape at every field size.
+    #[must_use]
+    pub fn path_camera(&self, t: f32, aspect: f32) -> Camera {
+        let (a, b) = self.field;
+        let diagonal = b - a;
+        let along = diagonal.normalize_or_zero();
+        let across = Vec3::new(-along.z, 0.0, along.x);
+        let length = 0.5 * diagonal.length();
+        let weave = (t * std::f32::consts::TAU).sin() * 0.1 * length.min(200.0);
+        let eye = a + along * (t * length) + across * weave + Vec3::Y * 3.0;
+        let ahead = eye + along * 20.0 + across * weave * 0.2 - Vec3::Y * 2.0;
+        Camera::looking(eye, ahead, aspect, 0.05, 2.0 * diagonal.length().max(1.0))
+    }
+
     /// The scene's update ([`InstancedScene::update`]) and the ground's
     /// camera.
     ///
@@ -110,21 +138,17 @@ impl<'m> DemoScene<'m> {
         queue: &wgpu::Queue,
         camera: &Camera,
         viewport_height: f32,
+        pixel_error: f32,
     ) -> Result<FrameStats> {
         self.ground.set_camera(queue, camera);
-        self.scene.update(device, queue, camera, viewport_height)
+        self.scene
+            .update(device, queue, camera, viewport_height, pixel_error)
     }
 
     /// The ground, then the instances.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
         self.ground.draw(pass);
         self.scene.draw(pass);
-    }
-
-    /// CPU and GPU bytes per instance.
-    #[must_use]
-    pub fn bytes_per_instance(&self) -> (usize, usize) {
-        self.scene.bytes_per_instance(self.model)
     }
 }
 

@@ -256,25 +256,16 @@ impl Renderer {
         })
     }
 
-    /// The scene row (see `mts bench render`) for `instances` copies of
-    /// `model` (called `name`), `frames` timed frames; `None` where the
-    /// instances' coherence caches would exceed the scene's cap.
+    /// A scene row (see `mts bench render --scene`) of `models`.
+    ///
+    /// # Errors
+    /// As [`super::bench_render::scene_row`].
     pub fn measure_scene(
         &self,
-        name: &str,
-        model: &MtsModel,
-        instances: usize,
-        frames: usize,
-    ) -> Result<Option<Scene>> {
-        super::bench_render::scene_row(
-            &self.gpu,
-            &self.target,
-            &self.config,
-            name,
-            model,
-            instances,
-            frames,
-        )
+        models: &[(String, &MtsModel)],
+        spec: &super::bench_render::SceneSpec,
+    ) -> Result<Scene> {
+        super::bench_render::scene_row(&self.gpu, &self.target, &self.config, models, spec)
     }
 
     /// Figure 6 rows of one baseline (see the module documentation).

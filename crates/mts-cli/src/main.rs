@@ -521,6 +521,20 @@ pub(crate) fn count_in<const MIN: u64, const MAX: u64>(
     Ok(n as usize)
 }
 
+/// `--pixel-error`: a finite number of pixels, 0 to 1000 (0: full
+/// detail).
+pub(crate) fn pixel_error(s: &str) -> std::result::Result<f32, String> {
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of pixels"))?;
+    if (0.0..=1000.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is outside 0..=1000 pixels"))
+    }
+}
+
 /// `--band-slack`: a number of at least [`mts::model::MIN_BAND_SLACK`]
 /// (`inf` is one band, as `--single-band`).
 fn band_slack(s: &str) -> std::result::Result<f64, String> {

@@ -100,12 +100,18 @@ pub struct RenderArgs {
     /// model built with them).
     #[arg(long, conflicts_with = "scene")]
     checker: bool,
-    /// Draw N instances of the model on a ground plane instead (each with
-    /// its own LoD from its projected size; 1000 when N is left out).
+    /// Draw N instances of the model on a ground plane instead (each at
+    /// the coarsest LoD within --pixel-error, drawn from buffers shared
+    /// by LoD bucket; 1000 when N is left out).
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
           conflicts_with_all = ["lod", "triangles", "ratio", "method"],
           allow_negative_numbers = true, value_parser = crate::count_in::<1, { 1 << 20 }>)]
     scene: Option<usize>,
+    /// With --scene: the screen-space error allowed, in pixels (0 draws
+    /// every instance at full detail).
+    #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR, requires = "scene",
+          value_parser = crate::pixel_error)]
+    pixel_error: f32,
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
@@ -239,16 +245,17 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     let config = RendererConfig::headless(report.strip_mode);
     let (device, queue) = (&gpu.device, &gpu.queue);
     let target = HeadlessTarget::new(device, width, height)?;
-    let mut scene = DemoScene::new(device, queue, &config, model, count)?;
+    let mut scene = DemoScene::new(device, queue, &config, &[model], count)?;
     let camera = scene.overview_camera(target.aspect());
+    let pixel_error = args.pixel_error;
     let t = Instant::now();
-    let first = scene.update(device, queue, &camera, height as f32)?;
+    let first = scene.update(device, queue, &camera, height as f32, pixel_error)?;
     let ms_first_update = t.elapsed().as_secs_f64() * 1e3;
     let mut times = Vec::new();
     let mut stats = first;
     for _ in 0..SCENE_FRAMES {
         let t = Instant::now();
-        stats = scene.update(device, queue, &camera, height as f32)?;
+        stats = scene.update(device, queue, &camera, height as f32, pixel_error)?;
         target.render(device, queue, |pass| scene.draw(pass))?;
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
@@ -256,7 +263,7 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     let ms_frame = times[times.len() / 2];
     let image = target.render_image(device, queue, |pass| scene.draw(pass))?;
     image.save_png(&args.output)?;
-    let (cpu_bytes, gpu_bytes) = scene.bytes_per_instance();
+    let memory = scene.scene.memory();
     if args.json {
         println!(
             "{}",
@@ -269,36 +276,49 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
                 "instances": count,
                 "visible": stats.visible,
                 "triangles": stats.triangles,
-                "indices_sent": stats.indices_sent,
+                "pixel_threshold": pixel_error,
+                "triangles_full_detail": stats.triangles_full_detail,
                 "indices_drawn": stats.indices_drawn,
-                "first_update_lod_changes": first.lod_changes,
+                "draws": stats.draws,
+                "buffers": memory.buffers,
+                "first_update_extractions": first.extractions,
                 "first_update_upload_bytes": first.upload_bytes,
                 "ms_first_update": ms_first_update,
                 "ms_frame": ms_frame,
                 "fps": 1e3 / ms_frame,
-                "bytes_per_instance_cpu": cpu_bytes,
-                "bytes_per_instance_gpu": gpu_bytes,
+                "cpu_bytes_per_instance": memory.cpu_bytes_per_instance(),
+                "cpu_shared_bytes": memory.cpu_shared_bytes,
+                "gpu_bytes": memory.gpu_bytes(),
+                "gpu_vertex_bytes": memory.gpu_vertex_bytes,
                 "output": args.output.display().to_string(),
             })
         );
     } else {
         print_text(name, &report, &args.output, |line| println!("{line}"));
         println!(
-            "  scene     {count} instances, {} visible after culling: {} triangles, {} indices sent \
-             ({} drawn with padding)",
-            stats.visible, stats.triangles, stats.indices_sent, stats.indices_drawn
+            "  scene     {count} instances, {} visible after culling: {} triangles ({:.1}% of full \
+             detail) at {pixel_error} px, {} indices drawn in {} instanced draws",
+            stats.visible,
+            stats.triangles,
+            100.0 * stats.triangles as f64 / stats.triangles_full_detail.max(1) as f64,
+            stats.indices_drawn,
+            stats.draws
         );
         println!(
-            "  time      first update {ms_first_update:.1} ms ({} LoD changes, {} bytes uploaded); \
-             frame {ms_frame:.1} ms ({:.1} fps, median of {SCENE_FRAMES})",
-            first.lod_changes,
+            "  time      first update {ms_first_update:.1} ms ({} buckets extracted, {} bytes \
+             uploaded); frame {ms_frame:.1} ms ({:.1} fps, median of {SCENE_FRAMES})",
+            first.extractions,
             first.upload_bytes,
             1e3 / ms_frame
         );
         println!(
-            "  memory    {:.1} KB CPU + {:.1} KB GPU per instance",
-            cpu_bytes as f64 / 1e3,
-            gpu_bytes as f64 / 1e3
+            "  memory    {} B CPU per instance, {:.1} KB CPU shared; GPU {:.1} KB in {} bucket \
+             buffers and transforms, {:.1} KB vertices",
+            memory.cpu_bytes_per_instance(),
+            memory.cpu_shared_bytes as f64 / 1e3,
+            memory.gpu_bytes() as f64 / 1e3,
+            memory.buffers,
+            memory.gpu_vertex_bytes as f64 / 1e3
         );
     }
     Ok(())

@@ -24,7 +24,7 @@ pub struct Results {
     /// `null` with `--quick`; rows, or why they are missing.
     pub fast_simplification: Option<FastSimplificationRun>,
     /// `null` without an adapter.
-    pub scene: Option<Scene>,
+    pub scenes: Vec<Scene>,
     /// Vertex properties against meshoptimizer's `simplifyWithAttributes`:
     /// one row per model with properties and share.
     pub properties: Vec<PropertyRow>,
@@ -302,18 +302,44 @@ pub struct FastSimplification {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
-    pub model: String,
+    /// Models, and their names.
+    pub models: u64,
+    pub model_names: Vec<String>,
     pub instances: u64,
     pub width: u32,
     pub height: u32,
-    pub visible: u64,
-    pub triangles: u64,
-    pub indices_sent: u64,
+    pub pixel_threshold: f64,
+    /// Frames along the camera path.
+    pub frames: u64,
+    /// Means per frame along the path.
+    pub visible: f64,
+    pub triangles_drawn: f64,
+    pub triangles_full_detail: f64,
+    pub indices_drawn: f64,
+    pub draws: f64,
+    pub extractions_per_frame: f64,
+    pub extractions_max: u64,
+    /// CPU bytes that grow with the instances, per instance; CPU bytes
+    /// per model.
     pub cpu_bytes_per_instance: u64,
-    pub ms_first_update: f64,
-    pub ms_per_frame: f64,
-    pub fps: f64,
-    pub triangles_per_second: f64,
+    pub cpu_shared_bytes: u64,
+    /// Peak GPU bytes of the bucket buffers and transforms; the models'
+    /// vertices; the sum of the models' full-detail strip buffers.
+    pub gpu_bytes: u64,
+    pub gpu_vertex_bytes: u64,
+    pub full_detail_strip_bytes: u64,
+    /// Peak live bucket buffers.
+    pub buffers: u64,
+    pub update_ms_median: f64,
+    pub update_ms_p99: f64,
+    pub frame_ms_median: f64,
+    /// Frames drawn also at full detail, and the share of the covered
+    /// pixels that differ (`null` when none were compared).
+    pub compared_frames: u64,
+    pub differing_pixel_share: Option<f64>,
+    /// The same, counting only pixels whose colour moved by more than
+    /// [`crate::figure6::IMAGE_TOLERANCE`] of 255 in a channel.
+    pub visibly_differing_pixel_share: Option<f64>,
 }
 
 impl Results {

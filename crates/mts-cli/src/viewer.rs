@@ -4,8 +4,8 @@
 //! Controls: drag with the left button (or the arrow keys) to orbit, `W`/`S`
 //! to move closer or farther; the mouse wheel, `Up`/`Down` or `+`/`-`
 //! change the LoD continuously (10% of the triangles per step); `A` toggles
-//! the automatic mode, which picks the LoD from the projected size (see
-//! [`mts_render::scene::PIXELS_PER_TRIANGLE`]); `Escape` quits. The
+//! the automatic mode, which picks the coarsest LoD whose error projects
+//! within one pixel ([`mts::lod_for_screen_error`]); `Escape` quits. The
 //! title shows triangles, indices sent, the last extraction's microseconds
 //! and frames per second.
 
@@ -15,7 +15,6 @@ use mts::model::Extractor;
 use mts::{Error, MtsModel, Result};
 use mts_render::camera::Camera;
 use mts_render::gpu::AdapterReport;
-use mts_render::scene::PIXELS_PER_TRIANGLE;
 use mts_render::strip_renderer::{RendererConfig, StripRenderer};
 use std::sync::Arc;
 use std::time::Instant;
@@ -331,7 +330,7 @@ impl<'m> State<'m> {
             }
             ViewerContent::Scene(n) => {
                 // Stitched on backends that ignore primitive restart.
-                let scene = DemoScene::new(&device, &queue, &renderer_config, model, n)?;
+                let scene = DemoScene::new(&device, &queue, &renderer_config, &[model], n)?;
                 let (lo, hi) = scene
                     .instances
                     .iter()
@@ -400,11 +399,18 @@ impl<'m> State<'m> {
             } => {
                 let model = extractor.model();
                 let lod = if self.auto {
+                    // The model's nearest point is about one bounding
+                    // radius nearer than the orbit's centre.
                     let row_y = camera.view_proj.row(1).truncate().length();
-                    let d = self.orbit.distance * self.orbit.radius;
-                    let r_px = self.orbit.radius * row_y * 0.5 * h as f32 / d;
-                    let budget = std::f32::consts::PI * r_px * r_px / PIXELS_PER_TRIANGLE;
-                    model.lod_for_triangles(budget.max(1.0) as usize)
+                    let nearest = (self.orbit.distance - 1.0).max(0.0) * self.orbit.radius;
+                    let ppu = row_y * 0.5 * h as f32 / nearest;
+                    mts::lod_for_screen_error(
+                        model.collapses(),
+                        2.0 * self.orbit.radius,
+                        1.0,
+                        ppu,
+                        mts_render::scene::DEFAULT_PIXEL_ERROR,
+                    )
                 } else {
                     model.lod_for_ratio(self.ratio)
                 };
@@ -418,7 +424,13 @@ impl<'m> State<'m> {
             }
             Drawn::Scene(scene) => {
                 let stats = scene
-                    .update(&self.device, &self.queue, &camera, h as f32)
+                    .update(
+                        &self.device,
+                        &self.queue,
+                        &camera,
+                        h as f32,
+                        mts_render::scene::DEFAULT_PIXEL_ERROR,
+                    )
                     .unwrap_or_else(|e| {
                         eprintln!("scene update: {e}");
                         mts_render::FrameStats::default()
@@ -426,7 +438,7 @@ impl<'m> State<'m> {
                 if stats.lod_changes > 0 {
                     self.extract_us = t.elapsed().as_secs_f64() * 1e6;
                 }
-                (stats.triangles, stats.indices_sent)
+                (stats.triangles, stats.indices_drawn)
             }
         };
         let frame = match self.surface.get_current_texture() {

@@ -4,8 +4,11 @@
 //! First one `StripRenderer`: it uploads vertices once, then after each LoD
 //! change the index ranges the extractor rewrote, and records its draw.
 //! Then an `InstancedScene` the host drives: two models, instances placed,
-//! moved every frame, removed and added, each given its LoD by its
-//! projected size, culled, drawn in the host's pass.
+//! moved every frame, removed and added, each given the coarsest LoD whose
+//! error projects within one pixel, drawn from buffers shared by all
+//! instances in its LoD bucket (one instanced draw per model and bucket),
+//! culled by the instance BVH (refitted when instances move, rebuilt when
+//! they come and go), drawn in the host's pass.
 //!
 //! Run with `cargo run --release -p mts-render --example embed` (lavapipe
 //! is enough).
@@ -148,18 +151,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         let t = Instant::now();
-        let stats = scene.update(&device, &queue, &camera, 480.0)?;
+        let stats = scene.update(
+            &device,
+            &queue,
+            &camera,
+            480.0,
+            mts_render::scene::DEFAULT_PIXEL_ERROR,
+        )?;
         let update_ms = t.elapsed().as_secs_f64() * 1e3;
         frame(&device, &queue, &color, &depth, |pass| scene.draw(pass))?;
         if step % 5 == 0 || step % 10 == 9 {
+            let memory = scene.memory();
             println!(
-                "scene frame {step:2}: {} instances, {} visible, {} triangles, {} LoD changes, \
-                 {} bytes uploaded; update {update_ms:.2} ms",
+                "scene frame {step:2}: {} instances, {} visible, {} triangles ({} at full \
+                 detail), {} draws, {} bucket changes, {} extractions, {} bytes uploaded, BVH \
+                 {:?}; update {update_ms:.2} ms; {} CPU bytes per instance, {} GPU bytes in {} \
+                 buffers",
                 scene.instance_count(),
                 stats.visible,
                 stats.triangles,
+                stats.triangles_full_detail,
+                stats.draws,
                 stats.lod_changes,
-                stats.upload_bytes
+                stats.extractions,
+                stats.upload_bytes,
+                stats.bvh,
+                memory.cpu_bytes_per_instance(),
+                memory.gpu_bytes(),
+                memory.buffers
             );
         }
     }

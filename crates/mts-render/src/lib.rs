@@ -29,7 +29,7 @@ pub mod texture;
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{Difference, HeadlessTarget, Image};
-pub use scene::{FrameStats, InstanceId, InstancedScene, ModelId};
+pub use scene::{BvhUpdate, FrameStats, InstanceId, InstancedScene, ModelId, SceneMemory};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload, VERTEX_BYTES};
 pub use texture::Appearance;
 /// The wgpu this renderer is built with, so that embedders use the same

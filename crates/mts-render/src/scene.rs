@@ -1,50 +1,69 @@
 //! A scene the host drives: several models, each with many instances at
-//! the host's own transforms, added, moved and removed at will; each
-//! instance gets its LoD from its projected size and its own coherence
-//! cache, and instances are culled against the view frustum through a BVH
-//! over their bounds (obvhs), rebuilt at the next update after instances
-//! were added, moved or removed (O(n log n); a frame without changes keeps
-//! it).
+//! the host's own transforms, added, moved and removed at will, drawn at
+//! levels of detail chosen by screen-space error and shared between
+//! instances.
 //!
-//! Per model: one [`StripRenderer`] (vertices, pipelines, camera), one
-//! index buffer holding a region per instance slot as long as the model's
-//! widest band (the extractor's `active_range` of any band fits), and one
-//! per-instance transform buffer. Within a band a LoD change uploads the
-//! instance's dirty ranges into its region; a band change uploads the new
-//! band's active range whole. Buffers grow by doubling; after a growth
-//! every region is written again. Each visible instance is one
-//! `draw_indexed` of its region with its transform.
+//! **LoD choice.** Each visible instance gets the coarsest LoD whose
+//! recorded error ([`mts::lod_for_screen_error`]), scaled by the instance's
+//! largest axis scale and projected at the nearest point of its bounding
+//! sphere, covers at most the host's pixel threshold.
 //!
-//! On a backend that ignores primitive restart ([`StripMode::Stitched`],
-//! wgpu's GL) each region holds the instance's runs stitched with
-//! degenerate triangles, rewritten whole when its LoD changes.
+//! **Shared extraction.** A model's LoDs are grouped in buckets: bucket
+//! `b` is the finest LoD with at most `T × (1 − s)^b` triangles (`T` the
+//! full count, `s` the spacing, [`DEFAULT_BUCKET_SPACING`]). An instance
+//! draws the coarsest bucket at least as fine as its LoD, so its error
+//! stays within the threshold and it draws at most about `1 / (1 − s)`
+//! times the triangles its LoD has. Every instance in a bucket draws the
+//! same index buffer, extracted once when the bucket is first needed and
+//! kept while instances use it (then for [`KEEP_UPDATES`] more updates, so
+//! an instance hovering at a boundary does not extract it again and
+//! again). One [`Extractor`] per model walks from bucket to bucket: a new
+//! bucket is extracted coherently from the last one, not from scratch, and
+//! its compact strips (or, on a backend that ignores primitive restart,
+//! [`StripMode::Stitched`], the strips stitched with degenerate triangles)
+//! are copied into the bucket's own buffer.
 //!
-//! Memory: every instance holds its extractor's slot buffer (4 bytes per
-//! slot index of the widest band) and a GPU region; see
-//! [`InstancedScene::bytes_per_instance`]. The ground, the grid layout and
-//! the demo camera of `mts render --scene` live in the CLI.
+//! **Drawing.** The visible instances' transforms are written each update
+//! into one instance buffer, grouped by (model, bucket); each group is one
+//! instanced `draw_indexed`.
+//!
+//! **Culling.** A BVH over the instances' bounds (obvhs) answers the
+//! frustum test. It is rebuilt (O(n log n)) at the next update after
+//! instances were added or removed, and refitted (O(n): leaves' boxes
+//! recomputed, then inner nodes) when instances only moved; after
+//! [`REFITS_BEFORE_REBUILD`] refits in a row it is rebuilt, since refitted
+//! boxes of instances that moved far apart grow loose.
+//!
+//! **Memory.** An instance holds its transform, bounds, scale, bucket and
+//! LoD (plus its share of the BVH and the per-update lists); the GPU holds
+//! the live buckets' index buffers, one instance buffer and each model's
+//! vertices. See [`InstancedScene::memory`]. The ground, the layout and the
+//! camera of `mts render --scene` live in the CLI.
 
 use super::camera::Camera;
 use super::gpu::StripMode;
 use super::strip_renderer::{write_index_range, RendererConfig, StripRenderer, INSTANCE_BYTES};
+use crate::texture::Appearance;
 use glam::{Mat4, Vec3, Vec4};
 use mts::model::Extractor;
 use mts::strip::encode::stitch_restart_buffer;
 use mts::{Error, MtsModel, Result};
-use std::ops::Range;
 
-/// Projected pixels per triangle that [`InstancedScene::update`] aims at:
-/// an instance whose bounding disc covers `A` pixels gets the finest LoD
-/// with at most `A / PIXELS_PER_TRIANGLE` triangles. At 4 the silhouette of
-/// a torus or bunny shows no facets at 1024 × 768 on lavapipe.
-pub const PIXELS_PER_TRIANGLE: f32 = 4.0;
+/// The default of [`InstancedScene::set_bucket_spacing`]: each bucket has
+/// about 10% fewer triangles than the next finer one.
+pub const DEFAULT_BUCKET_SPACING: f32 = 0.1;
+
+/// The default pixel threshold of the LoD choice.
+pub const DEFAULT_PIXEL_ERROR: f32 = 1.0;
+
+/// Updates a bucket no instance uses is kept before its buffer is freed.
+pub const KEEP_UPDATES: u32 = 30;
+
+/// Refits of the instance BVH in a row before it is rebuilt.
+pub const REFITS_BEFORE_REBUILD: u32 = 64;
 
 /// Most instances an [`InstancedScene`] holds, over all its models.
-pub const MAX_INSTANCES: usize = 1 << 20;
-
-/// Most bytes of per-instance coherence caches an [`InstancedScene`]
-/// holds (2 GiB).
-pub const MAX_CACHE_BYTES: usize = 2 << 30;
+pub const MAX_INSTANCES: usize = 1 << 22;
 
 /// A model added to a scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -70,17 +89,74 @@ impl InstanceId {
 pub struct FrameStats {
     /// Instances inside the view frustum (drawn).
     pub visible: usize,
-    /// Triangles of the visible instances at their LoDs.
+    /// Triangles the visible instances draw (their buckets' counts).
     pub triangles: usize,
-    /// Indices a compact buffer of the visible instances holds (restarts
-    /// included): what strips send.
-    pub indices_sent: usize,
-    /// Indices the draws read (slot padding included).
+    /// Triangles the visible instances would draw at full detail.
+    pub triangles_full_detail: usize,
+    /// Indices the draws read (restarts, or stitching, included).
     pub indices_drawn: usize,
-    /// Visible instances whose LoD changed.
+    /// Visible instances whose bucket changed (or that were not drawn in
+    /// the previous update).
     pub lod_changes: usize,
-    /// Bytes written to the index buffers.
+    /// Buckets extracted by this update.
+    pub extractions: usize,
+    /// Buckets whose buffers were freed by this update.
+    pub evictions: usize,
+    /// Instanced draws recorded ((model, bucket) groups).
+    pub draws: usize,
+    /// Bytes written to the GPU (bucket indices and instance transforms).
     pub upload_bytes: usize,
+    /// Whether the instance BVH was rebuilt, refitted or kept.
+    pub bvh: BvhUpdate,
+}
+
+/// What an update did to the instance BVH.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BvhUpdate {
+    /// Nothing moved.
+    #[default]
+    Kept,
+    /// Instances moved: boxes refitted.
+    Refitted,
+    /// Instances were added or removed (or refits ran long): built anew.
+    Rebuilt,
+}
+
+/// Where a scene's memory goes ([`InstancedScene::memory`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SceneMemory {
+    /// Instances.
+    pub instances: usize,
+    /// CPU bytes that grow with the instances: the instance records, the
+    /// BVH and the per-update lists (capacities, not lengths).
+    pub cpu_instance_bytes: usize,
+    /// CPU bytes per model, shared by its instances: the walking
+    /// extractor and the bucket table.
+    pub cpu_shared_bytes: usize,
+    /// GPU bytes of the live buckets' index buffers.
+    pub gpu_index_bytes: usize,
+    /// GPU bytes of the instance buffer.
+    pub gpu_instance_bytes: usize,
+    /// GPU bytes of the models' vertex buffers.
+    pub gpu_vertex_bytes: usize,
+    /// Live bucket buffers.
+    pub buffers: usize,
+}
+
+impl SceneMemory {
+    /// [`SceneMemory::cpu_instance_bytes`] per instance (0 for none).
+    #[must_use]
+    pub fn cpu_bytes_per_instance(&self) -> usize {
+        self.cpu_instance_bytes
+            .checked_div(self.instances)
+            .unwrap_or(0)
+    }
+
+    /// GPU bytes beyond the vertices: bucket indices and transforms.
+    #[must_use]
+    pub fn gpu_bytes(&self) -> usize {
+        self.gpu_index_bytes + self.gpu_instance_bytes
+    }
 }
 
 /// A bounding sphere, world space.
@@ -90,62 +166,92 @@ struct Bound {
     radius: f32,
 }
 
-/// One placed copy of a model.
-#[derive(Debug)]
-struct Slot<'m> {
+/// "None" for an instance's bucket, and the mark of a free slot.
+const NONE: u32 = u32::MAX;
+
+/// One placed copy of a model: what it costs per instance.
+#[derive(Debug, Clone, Copy)]
+struct Instance {
     transform: Mat4,
     bound: Bound,
-    extractor: Extractor<'m>,
-    /// What its region holds now: the active range (restart) or the
-    /// stitched length (from 0).
-    held: Range<usize>,
-    /// Whether its region holds what `held` says (false after a growth).
-    written: bool,
+    /// Largest axis scale of `transform`.
+    scale: f32,
+    /// Bucket drawn in the last update ([`NONE`]: not drawn).
+    bucket: u32,
+    /// LoD the error asked for in the last update.
+    lod: u32,
+    /// Whether the slot holds an instance.
+    live: bool,
 }
 
-/// A model with its renderer, its buffers and its instances' slots.
+/// A group of LoDs drawn as one: its LoD and, while live, its buffer.
+#[derive(Debug)]
+struct Bucket {
+    lod: u32,
+    triangles: u32,
+    buffer: Option<wgpu::Buffer>,
+    /// Indices the buffer holds.
+    len: u32,
+    /// Instances drawing it in the current update.
+    users: u32,
+    /// Updates since it was last used.
+    idle: u32,
+    /// First transform of its group in the instance buffer, and how many
+    /// are placed so far (this update).
+    first: u32,
+    placed: u32,
+}
+
+/// A model with its renderer, its buckets and its instances.
 #[derive(Debug)]
 struct ModelEntry<'m> {
     model: &'m MtsModel,
     renderer: StripRenderer,
     /// The model's bounding sphere in model space.
     local: Bound,
-    /// Indices per instance region (even).
-    region: usize,
-    /// CPU bytes of one instance's extractor.
-    cpu_per_instance: usize,
-    /// Slots the buffers hold.
-    capacity: usize,
-    index_buffer: wgpu::Buffer,
-    instance_buffer: wgpu::Buffer,
-    slots: Vec<Option<Slot<'m>>>,
+    /// The input's bounding-box diagonal (the unit of the errors).
+    diagonal: f32,
+    /// Walks from bucket to bucket.
+    cursor: Extractor<'m>,
+    buckets: Vec<Bucket>,
+    slots: Vec<Instance>,
     free: Vec<u32>,
-    /// Slots whose transform is not uploaded yet.
-    moved: Vec<u32>,
 }
 
 /// Several models, each with instances the host places (see the module
 /// docs).
-#[derive(Debug)]
 pub struct InstancedScene<'m> {
     config: RendererConfig,
+    spacing: f32,
     models: Vec<ModelEntry<'m>>,
     live: usize,
-    cpu_bytes: usize,
-    /// Instances in the BVH's order, and the BVH over their bounds; stale
-    /// while `dirty`.
+    /// Instances in the BVH's order, and the BVH over their bounds.
     order: Vec<InstanceId>,
-    bounds: Vec<Bound>,
-    bvh_nodes: Vec<obvhs::bvh2::node::Bvh2Node>,
-    bvh_leaves: Vec<u32>,
-    dirty: bool,
+    bvh: Option<obvhs::bvh2::Bvh2>,
+    /// Instances were added or removed / moved since the BVH was made.
+    rebuild: bool,
+    refit: bool,
+    refits: u32,
     stack: Vec<u32>,
     candidates: Vec<u32>,
     /// Visible instances of the last update, ascending.
     visible: Vec<InstanceId>,
+    instance_buffer: Option<wgpu::Buffer>,
+    instance_capacity: usize,
+    compact: Vec<u32>,
+    stitched: Vec<u32>,
     scratch: Vec<u16>,
-    stitch_scratch: Vec<u32>,
-    transform_scratch: Vec<f32>,
+}
+
+impl std::fmt::Debug for InstancedScene<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("InstancedScene")
+            .field("models", &self.models.len())
+            .field("instances", &self.live)
+            .field("visible", &self.visible.len())
+            .field("bvh_nodes", &self.bvh.as_ref().map_or(0, |b| b.nodes.len()))
+            .finish_non_exhaustive()
+    }
 }
 
 impl<'m> InstancedScene<'m> {
@@ -155,60 +261,70 @@ impl<'m> InstancedScene<'m> {
     pub fn new(config: &RendererConfig) -> InstancedScene<'m> {
         InstancedScene {
             config: *config,
+            spacing: DEFAULT_BUCKET_SPACING,
             models: Vec::new(),
             live: 0,
-            cpu_bytes: 0,
             order: Vec::new(),
-            bounds: Vec::new(),
-            bvh_nodes: Vec::new(),
-            bvh_leaves: Vec::new(),
-            dirty: false,
+            bvh: None,
+            rebuild: false,
+            refit: false,
+            refits: 0,
             stack: Vec::new(),
             candidates: Vec::new(),
             visible: Vec::new(),
+            instance_buffer: None,
+            instance_capacity: 0,
+            compact: Vec::new(),
+            stitched: Vec::new(),
             scratch: Vec::new(),
-            stitch_scratch: Vec::new(),
-            transform_scratch: Vec::new(),
         }
     }
 
-    /// Adds `model`: its vertices are uploaded once, its instances share
-    /// them.
+    /// Sets the bucket spacing `s` (see the module docs) for the models
+    /// added from now on: 0.01 to 0.9; wider buckets hold fewer buffers and
+    /// draw more triangles.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] outside 0.01..=0.9.
+    pub fn set_bucket_spacing(&mut self, spacing: f32) -> Result<()> {
+        if !(0.01..=0.9).contains(&spacing) {
+            return Err(Error::InvalidArgument(format!(
+                "bucket spacing {spacing} is outside 0.01..=0.9"
+            )));
+        }
+        self.spacing = spacing;
+        Ok(())
+    }
+
+    /// Adds `model`: its vertices (and their properties and texture, as
+    /// [`StripRenderer::for_model_with`]) are uploaded once, its instances
+    /// share them and its buckets.
     ///
     /// # Errors
     /// [`Error::Gpu`] or [`Error::InvalidArgument`] as
-    /// [`StripRenderer::for_model`].
+    /// [`StripRenderer::for_model_with`].
     ///
-    /// Cost: the vertex upload and one walk per band (the widest band's
-    /// span).
+    /// Cost: the vertex upload, and O(buckets × log LoDs) for the bucket
+    /// table; nothing is extracted until an instance needs it.
     pub fn add_model(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         model: &'m MtsModel,
     ) -> Result<ModelId> {
-        let renderer = StripRenderer::for_model(device, queue, &self.config, model)?;
+        if self.models.len() >= u32::MAX as usize {
+            return Err(Error::InvalidArgument("too many models".into()));
+        }
+        let renderer = StripRenderer::for_model_with(
+            device,
+            queue,
+            &self.config,
+            model,
+            &Appearance::default(),
+        )?;
         let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
-        let radius = ((mts::mesh::diagonal_of(min, max) * 0.5) as f32).max(f32::MIN_POSITIVE);
-        let mut probe = Extractor::new(model);
-        let cpu_per_instance = 4 * probe.buffer().len();
-        let widest = (0..model.band_count())
-            .map(|b| {
-                probe.set_lod(model.band_first_lod(b));
-                probe.active_range().len()
-            })
-            .max()
-            .unwrap_or(0);
-        // Stitching turns each restart into at most three repeated indices
-        // and runs hold at least four entries with their restart, so twice
-        // the widest active range holds any stitched one (and the padding
-        // index a 16-bit write may add).
-        let region = if self.config.strip_mode == StripMode::Stitched {
-            2 * widest + 4
-        } else {
-            ((widest + 1) & !1).max(2)
-        };
-        let (index_buffer, instance_buffer) = buffers(device, &renderer, region, 1)?;
+        let diagonal = mts::mesh::diagonal_of(min, max) as f32;
+        let radius = (diagonal * 0.5).max(f32::MIN_POSITIVE);
         self.models.push(ModelEntry {
             model,
             renderer,
@@ -216,66 +332,57 @@ impl<'m> InstancedScene<'m> {
                 centre: (min + max) * 0.5,
                 radius,
             },
-            region,
-            cpu_per_instance,
-            capacity: 1,
-            index_buffer,
-            instance_buffer,
+            diagonal,
+            cursor: Extractor::new(model),
+            buckets: buckets(model, self.spacing),
             slots: Vec::new(),
             free: Vec::new(),
-            moved: Vec::new(),
         });
         Ok(ModelId(self.models.len() as u32 - 1))
     }
 
-    /// Adds an instance of `model` at `transform` (model to world: a
-    /// rotation, a translation and a uniform scale). It is drawn from the
-    /// next [`InstancedScene::update`] on.
+    /// Adds an instance of `model` at `transform` (model to world). It is
+    /// drawn from the next [`InstancedScene::update`] on.
     ///
     /// # Errors
-    /// [`Error::InvalidArgument`] past [`MAX_INSTANCES`] or
-    /// [`MAX_CACHE_BYTES`], or for a transform whose bounds are not finite.
+    /// [`Error::InvalidArgument`] for a model not of this scene, past
+    /// [`MAX_INSTANCES`], or for a transform whose bounds are not finite.
     ///
-    /// Cost: one extractor (O(strips)); no GPU work until the update.
+    /// Cost: O(1); the BVH is rebuilt at the next update.
     pub fn add_instance(&mut self, model: ModelId, transform: Mat4) -> Result<InstanceId> {
-        let entry = &mut self.models[model.0 as usize];
         if self.live >= MAX_INSTANCES {
             return Err(Error::InvalidArgument(format!(
                 "a scene holds at most {MAX_INSTANCES} instances"
             )));
         }
-        if self.cpu_bytes + entry.cpu_per_instance > MAX_CACHE_BYTES {
-            return Err(Error::InvalidArgument(format!(
-                "another instance would take the coherence caches past {MAX_CACHE_BYTES} bytes \
-                 ({} each)",
-                entry.cpu_per_instance
-            )));
-        }
-        let bound = place(entry.local, transform)?;
-        let slot = Slot {
+        let entry = self
+            .models
+            .get_mut(model.0 as usize)
+            .ok_or_else(|| Error::InvalidArgument(format!("no model {model:?}")))?;
+        let (bound, scale) = place(entry.local, transform)?;
+        let instance = Instance {
             transform,
             bound,
-            extractor: Extractor::new(entry.model),
-            held: 0..0,
-            written: false,
+            scale,
+            bucket: NONE,
+            lod: 0,
+            live: true,
         };
-        let index = match entry.free.pop() {
+        let slot = match entry.free.pop() {
             Some(i) => {
-                entry.slots[i as usize] = Some(slot);
+                entry.slots[i as usize] = instance;
                 i
             }
             None => {
-                entry.slots.push(Some(slot));
+                entry.slots.push(instance);
                 entry.slots.len() as u32 - 1
             }
         };
-        entry.moved.push(index);
         self.live += 1;
-        self.cpu_bytes += entry.cpu_per_instance;
-        self.dirty = true;
+        self.rebuild = true;
         Ok(InstanceId {
             model: model.0,
-            slot: index,
+            slot,
         })
     }
 
@@ -284,35 +391,42 @@ impl<'m> InstancedScene<'m> {
     /// # Errors
     /// [`Error::InvalidArgument`] for an instance that was removed or a
     /// transform whose bounds are not finite.
+    ///
+    /// Cost: O(1); the BVH is refitted at the next update.
     pub fn set_transform(&mut self, id: InstanceId, transform: Mat4) -> Result<()> {
-        let entry = &mut self.models[id.model as usize];
+        let entry = self
+            .models
+            .get_mut(id.model as usize)
+            .ok_or_else(|| Error::InvalidArgument(format!("no instance {id:?}")))?;
         let local = entry.local;
         let slot = entry
             .slots
             .get_mut(id.slot as usize)
-            .and_then(Option::as_mut)
+            .filter(|s| s.live)
             .ok_or_else(|| Error::InvalidArgument(format!("no instance {id:?}")))?;
-        slot.bound = place(local, transform)?;
+        (slot.bound, slot.scale) = place(local, transform)?;
         slot.transform = transform;
-        entry.moved.push(id.slot);
-        self.dirty = true;
+        self.refit = true;
         Ok(())
     }
 
     /// Removes instance `id` (its slot is reused by a later instance).
     /// Returns whether it was there.
     pub fn remove_instance(&mut self, id: InstanceId) -> bool {
-        let entry = &mut self.models[id.model as usize];
+        let Some(entry) = self.models.get_mut(id.model as usize) else {
+            return false;
+        };
         let Some(slot) = entry.slots.get_mut(id.slot as usize) else {
             return false;
         };
-        if slot.take().is_none() {
+        if !slot.live {
             return false;
         }
+        slot.live = false;
+        slot.bucket = NONE;
         entry.free.push(id.slot);
         self.live -= 1;
-        self.cpu_bytes -= entry.cpu_per_instance;
-        self.dirty = true;
+        self.rebuild = true;
         true
     }
 
@@ -336,221 +450,420 @@ impl<'m> InstancedScene<'m> {
         &self.visible
     }
 
-    /// The LoD instance `id` holds now (`None` before it was first seen,
-    /// or once removed).
+    /// The LoD instance `id` drew in the last update (its bucket's), `None`
+    /// when it was not drawn or is removed.
     #[must_use]
     pub fn lod_of(&self, id: InstanceId) -> Option<usize> {
-        self.slot(id)?.extractor.lod()
+        let slot = self.slot(id)?;
+        let b = self.models[id.model as usize]
+            .buckets
+            .get(slot.bucket as usize)?;
+        Some(b.lod as usize)
     }
 
-    /// Bytes an instance of `model` costs: its extractor's slot buffer
-    /// (CPU) and its index region (GPU).
+    /// The LoD the screen-space error asked for instance `id` in the last
+    /// update (its bucket is at least as fine), `None` as
+    /// [`InstancedScene::lod_of`].
     #[must_use]
-    pub fn bytes_per_instance(&self, model: ModelId) -> (usize, usize) {
-        let entry = &self.models[model.0 as usize];
-        (
-            entry.cpu_per_instance,
-            index_size(&entry.renderer) as usize * entry.region,
-        )
+    pub fn wanted_lod_of(&self, id: InstanceId) -> Option<usize> {
+        let slot = self.slot(id)?;
+        (slot.bucket != NONE).then_some(slot.lod as usize)
     }
 
-    fn slot(&self, id: InstanceId) -> Option<&Slot<'m>> {
+    /// Where the scene's memory goes now.
+    #[must_use]
+    pub fn memory(&self) -> SceneMemory {
+        let mut m = SceneMemory {
+            instances: self.live,
+            ..SceneMemory::default()
+        };
+        for entry in &self.models {
+            // Slots (live or free) and the free list.
+            m.cpu_instance_bytes += entry.slots.capacity() * std::mem::size_of::<Instance>()
+                + entry.free.capacity() * 4;
+            m.cpu_shared_bytes += 4 * entry.cursor.buffer().len()
+                + entry.buckets.capacity() * std::mem::size_of::<Bucket>();
+            m.gpu_vertex_bytes += entry.renderer.vertex_count() * crate::VERTEX_BYTES;
+            for b in &entry.buckets {
+                if let Some(buffer) = &b.buffer {
+                    m.gpu_index_bytes += buffer.size() as usize;
+                    m.buffers += 1;
+                }
+            }
+        }
+        m.cpu_instance_bytes += self.order.capacity() * std::mem::size_of::<InstanceId>()
+            + self.candidates.capacity() * 4
+            + self.stack.capacity() * 4
+            + self.visible.capacity() * std::mem::size_of::<InstanceId>();
+        if let Some(bvh) = &self.bvh {
+            m.cpu_instance_bytes += bvh.nodes.capacity()
+                * std::mem::size_of::<obvhs::bvh2::node::Bvh2Node>()
+                + bvh.primitive_indices.capacity() * 4
+                + bvh.primitives_to_nodes.capacity() * 4
+                + bvh.parents.capacity() * 4;
+        }
+        m.gpu_instance_bytes = self
+            .instance_buffer
+            .as_ref()
+            .map_or(0, |b| b.size() as usize);
+        m
+    }
+
+    fn slot(&self, id: InstanceId) -> Option<&Instance> {
         self.models
             .get(id.model as usize)?
             .slots
-            .get(id.slot as usize)?
-            .as_ref()
+            .get(id.slot as usize)
+            .filter(|s| s.live)
     }
 
-    /// Culls the instances against `camera`'s frustum (a BVH over their
-    /// bounding boxes, then each candidate's sphere; the BVH is rebuilt
-    /// first when instances changed), gives each visible instance the
-    /// finest LoD with at most its projected disc area (in pixels of a
-    /// viewport `viewport_height` pixels high) divided by
-    /// [`PIXELS_PER_TRIANGLE`] triangles, extracts it through its own
-    /// coherence cache and uploads what changed: transforms of moved
-    /// instances, index ranges of changed LoDs. Instances out of view keep
-    /// their LoD and cost nothing. Also writes the camera.
+    /// Culls the instances against `camera`'s frustum, gives each visible
+    /// instance its LoD by screen-space error (`pixel_error` pixels at a
+    /// viewport `viewport_height` pixels high) and its bucket, extracts
+    /// the buckets that became needed, frees those unused for
+    /// [`KEEP_UPDATES`] updates, and writes the visible instances'
+    /// transforms grouped by bucket. Also writes the camera.
     ///
     /// # Errors
-    /// [`Error::Gpu`] when a model's buffers would pass the device's
-    /// `max_buffer_size` as they grow.
+    /// [`Error::Gpu`] when a buffer would pass the device's
+    /// `max_buffer_size`.
     ///
-    /// Cost: O(visible · log instances) for culling, plus the extraction and
-    /// upload of the instances whose LoD changed, plus O(n log n) for the
-    /// BVH after a change of instances.
+    /// Cost: O(visible · log instances) for culling, O(visible · log LoDs)
+    /// for the LoD choice, the coherent walks between the buckets
+    /// extracted, O(visible) for the transforms; plus O(n log n) for the
+    /// BVH after instances were added or removed, O(n) after they moved.
     pub fn update(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         camera: &Camera,
         viewport_height: f32,
+        pixel_error: f32,
     ) -> Result<FrameStats> {
+        let mut stats = FrameStats::default();
         for entry in &mut self.models {
             entry.renderer.set_camera(queue, camera);
-            grow(device, entry)?;
-            upload_transforms(queue, entry, &mut self.transform_scratch);
         }
-        if self.dirty {
-            self.rebuild_bvh();
+        stats.bvh = self.update_bvh();
+        {
+            let (order, models) = (&self.order, &self.models);
+            cull(
+                self.bvh.as_ref(),
+                |p| {
+                    let id = order[p as usize];
+                    models[id.model as usize].slots[id.slot as usize].bound
+                },
+                &frustum_planes(camera.view_proj),
+                &mut self.stack,
+                &mut self.candidates,
+            );
         }
-        let planes = frustum_planes(camera.view_proj);
+        // Last update's buckets, to count changes; then this update's.
+        for entry in &mut self.models {
+            for b in &mut entry.buckets {
+                b.users = 0;
+                b.placed = 0;
+            }
+        }
         // Pixels per world unit at view depth 1: the projection's y scale
         // (the length of the matrix's second row, the view being a
         // rotation) times half the viewport.
         let row_y = camera.view_proj.row(1).truncate().length();
         let row_w = camera.view_proj.row(3);
-        let px_per_unit = row_y * 0.5 * viewport_height;
-        let mut stats = FrameStats::default();
-        cull(
-            &self.bvh_nodes,
-            &self.bvh_leaves,
-            &self.bounds,
-            &planes,
-            &mut self.stack,
-            &mut self.candidates,
-        );
-        self.visible.clear();
+        let px_at_1 = row_y * 0.5 * viewport_height;
+        let previous = std::mem::take(&mut self.visible);
         self.visible
             .extend(self.candidates.iter().map(|&i| self.order[i as usize]));
         self.visible.sort_unstable();
-        let stitched = self.config.strip_mode == StripMode::Stitched;
+        for &id in &previous {
+            if self.visible.binary_search(&id).is_err() {
+                if let Some(s) = self.models[id.model as usize]
+                    .slots
+                    .get_mut(id.slot as usize)
+                {
+                    s.bucket = NONE;
+                }
+            }
+        }
         for &id in &self.visible {
             let entry = &mut self.models[id.model as usize];
-            let (format, region, model) =
-                (entry.renderer.index_format(), entry.region, entry.model);
-            let slot = entry.slots[id.slot as usize]
-                .as_mut()
-                .expect("visible instances are live");
-            let depth = row_w
-                .dot(slot.bound.centre.extend(1.0))
-                .max(slot.bound.radius);
-            let r_px = slot.bound.radius * px_per_unit / depth;
-            let budget = (std::f32::consts::PI * r_px * r_px / PIXELS_PER_TRIANGLE) as usize;
-            let lod = model.lod_for_triangles(budget.max(1));
-            let ex = &mut slot.extractor;
-            let changed = ex.lod() != Some(lod);
-            if changed {
-                ex.set_lod(lod);
+            let slot = &mut entry.slots[id.slot as usize];
+            let depth = row_w.dot(slot.bound.centre.extend(1.0));
+            let nearest = (depth - slot.bound.radius).max(0.0);
+            let ppu = if nearest > 0.0 {
+                px_at_1 / nearest
+            } else {
+                f32::INFINITY
+            };
+            let lod = mts::lod_for_screen_error(
+                entry.model.collapses(),
+                entry.diagonal,
+                slot.scale,
+                ppu,
+                pixel_error,
+            );
+            // The coarsest bucket at least as fine as `lod`.
+            let bucket = entry.buckets.partition_point(|b| b.lod as usize <= lod) - 1;
+            if slot.bucket != bucket as u32 {
                 stats.lod_changes += 1;
             }
-            let base = id.slot as usize * region;
-            if stitched && (changed || !slot.written) {
-                stitch_restart_buffer(&ex.buffer()[ex.active_range()], &mut self.stitch_scratch);
-                let n = self.stitch_scratch.len();
-                slot.held = 0..n;
-                if n > 0 {
-                    stats.upload_bytes += write_index_range(
-                        queue,
-                        &entry.index_buffer,
-                        format,
-                        &self.stitch_scratch,
-                        0..n,
-                        base,
-                        &mut self.scratch,
-                    );
-                }
-            } else if changed || !slot.written {
-                if !slot.written {
-                    slot.held = 0..0;
-                }
-                stats.upload_bytes += upload_instance(
-                    queue,
-                    &entry.index_buffer,
-                    format,
-                    base,
-                    ex,
-                    &mut slot.held,
-                    &mut self.scratch,
-                );
-            }
-            slot.written = true;
-            stats.triangles += model.triangle_count(lod);
-            stats.indices_sent += if stitched {
-                slot.held.len()
-            } else {
-                ex.indices_sent()
-            };
-            stats.indices_drawn += slot.held.len();
+            slot.bucket = bucket as u32;
+            slot.lod = lod as u32;
+            let b = &mut entry.buckets[bucket];
+            b.users += 1;
+            stats.triangles += b.triangles as usize;
+            stats.triangles_full_detail += entry.model.triangle_count(0);
         }
+        // Extract what is newly needed (finer to coarser, each from the
+        // last), free what has been idle too long, and lay out the groups.
+        let stitched = self.config.strip_mode == StripMode::Stitched;
+        let mut groups = 0u32;
+        for entry in &mut self.models {
+            let format = entry.renderer.index_format();
+            for b in &mut entry.buckets {
+                if b.users == 0 {
+                    b.idle = b.idle.saturating_add(1);
+                    if b.buffer.is_some() && b.idle > KEEP_UPDATES {
+                        b.buffer = None;
+                        stats.evictions += 1;
+                    }
+                    continue;
+                }
+                b.idle = 0;
+                b.first = groups;
+                groups += b.users;
+                stats.draws += 1;
+                if b.buffer.is_some() {
+                    continue;
+                }
+                entry.cursor.set_lod(b.lod as usize);
+                entry.cursor.write_compact(&mut self.compact);
+                let indices = if stitched {
+                    stitch_restart_buffer(&self.compact, &mut self.stitched);
+                    &self.stitched
+                } else {
+                    &self.compact
+                };
+                b.len = indices.len() as u32;
+                let (buffer, bytes) =
+                    index_buffer(device, queue, format, indices, &mut self.scratch)?;
+                b.buffer = Some(buffer);
+                stats.upload_bytes += bytes;
+                stats.extractions += 1;
+            }
+        }
+        // Counted once every bucket drawn is extracted.
+        stats.indices_drawn = self
+            .visible
+            .iter()
+            .map(|id| {
+                let entry = &self.models[id.model as usize];
+                entry.buckets[entry.slots[id.slot as usize].bucket as usize].len as usize
+            })
+            .sum();
+        stats.upload_bytes += self.write_transforms(device, queue, groups as usize)?;
         stats.visible = self.visible.len();
         Ok(stats)
     }
 
-    /// Records one draw per visible instance into `pass`, model by model.
+    /// Writes the visible instances' transforms, each at its bucket's
+    /// group; grows the instance buffer (doubling) when needed. Returns
+    /// the bytes written.
+    fn write_transforms(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        count: usize,
+    ) -> Result<usize> {
+        if count == 0 {
+            return Ok(0);
+        }
+        if count > self.instance_capacity {
+            let capacity = count.next_power_of_two();
+            let bytes = capacity as u64 * INSTANCE_BYTES;
+            let max = device.limits().max_buffer_size;
+            if bytes > max {
+                return Err(Error::Gpu(format!(
+                    "{count} visible instances need a {bytes}-byte instance buffer, above the \
+                     device's max_buffer_size {max}"
+                )));
+            }
+            self.instance_buffer = Some(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("mts scene instances"),
+                size: bytes,
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+            self.instance_capacity = capacity;
+        }
+        let buffer = self.instance_buffer.as_ref().expect("made above");
+        let size = count as u64 * INSTANCE_BYTES;
+        let Some(mut view) =
+            queue.write_buffer_with(buffer, 0, wgpu::BufferSize::new(size).expect("count > 0"))
+        else {
+            return Err(Error::Gpu(
+                "cannot map the instance buffer for writing".into(),
+            ));
+        };
+        for &id in &self.visible {
+            let entry = &mut self.models[id.model as usize];
+            let slot = &entry.slots[id.slot as usize];
+            let b = &mut entry.buckets[slot.bucket as usize];
+            let at = (b.first + b.placed) as usize * INSTANCE_BYTES as usize;
+            b.placed += 1;
+            view.slice(at..at + INSTANCE_BYTES as usize)
+                .copy_from_slice(bytemuck::cast_slice(&slot.transform.to_cols_array()));
+        }
+        Ok(size as usize)
+    }
+
+    /// Records one instanced draw per (model, bucket) with visible
+    /// instances into `pass`.
     ///
     /// Cost: three binds per model with visible instances plus one
-    /// `draw_indexed` per visible instance.
+    /// `draw_indexed` per group.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
-        let mut bound = u32::MAX;
-        for &id in &self.visible {
-            let entry = &self.models[id.model as usize];
-            let Some(slot) = &entry.slots[id.slot as usize] else {
-                continue;
-            };
-            if slot.held.is_empty() {
-                continue;
+        let Some(instances) = &self.instance_buffer else {
+            return;
+        };
+        for entry in &self.models {
+            let mut bound = false;
+            for b in &entry.buckets {
+                let (Some(buffer), true) = (&b.buffer, b.users > 0) else {
+                    continue;
+                };
+                if b.len == 0 {
+                    continue;
+                }
+                if !bound {
+                    entry.renderer.bind(pass, true);
+                    pass.set_vertex_buffer(1, instances.slice(..));
+                    bound = true;
+                }
+                pass.set_index_buffer(buffer.slice(..), entry.renderer.index_format());
+                pass.draw_indexed(0..b.len, 0, b.first..b.first + b.users);
             }
-            if bound != id.model {
-                entry.renderer.bind(pass, true);
-                pass.set_vertex_buffer(1, entry.instance_buffer.slice(..));
-                pass.set_index_buffer(entry.index_buffer.slice(..), entry.renderer.index_format());
-                bound = id.model;
-            }
-            let base = id.slot as usize * entry.region;
-            pass.draw_indexed(
-                base as u32..(base + slot.held.len()) as u32,
-                0,
-                id.slot..id.slot + 1,
-            );
         }
     }
 
-    /// The live instances and their bounds, and a BVH over them.
-    fn rebuild_bvh(&mut self) {
-        self.order.clear();
-        self.bounds.clear();
-        for (m, entry) in self.models.iter().enumerate() {
-            for (s, slot) in entry.slots.iter().enumerate() {
-                if let Some(slot) = slot {
-                    self.order.push(InstanceId {
-                        model: m as u32,
-                        slot: s as u32,
-                    });
-                    self.bounds.push(slot.bound);
+    /// Rebuilds the BVH after instances were added or removed (or after
+    /// [`REFITS_BEFORE_REBUILD`] refits), refits it after they moved.
+    fn update_bvh(&mut self) -> BvhUpdate {
+        if self.rebuild || (self.refit && self.refits >= REFITS_BEFORE_REBUILD) {
+            self.order.clear();
+            let mut boxes = Vec::with_capacity(self.live);
+            for (m, entry) in self.models.iter().enumerate() {
+                for (s, slot) in entry.slots.iter().enumerate() {
+                    if slot.live {
+                        self.order.push(InstanceId {
+                            model: m as u32,
+                            slot: s as u32,
+                        });
+                        boxes.push(aabb(slot.bound));
+                    }
                 }
             }
+            self.bvh = (!boxes.is_empty()).then(|| build_bvh(&boxes));
+            (self.rebuild, self.refit, self.refits) = (false, false, 0);
+            return BvhUpdate::Rebuilt;
         }
-        (self.bvh_nodes, self.bvh_leaves) = bvh_over(&self.bounds);
-        self.dirty = false;
+        if !self.refit {
+            return BvhUpdate::Kept;
+        }
+        self.refit = false;
+        self.refits += 1;
+        if let Some(bvh) = &mut self.bvh {
+            let (order, models) = (&self.order, &self.models);
+            refit(bvh, |p| {
+                let id = order[p as usize];
+                models[id.model as usize].slots[id.slot as usize].bound
+            });
+        }
+        BvhUpdate::Refitted
     }
 }
 
-/// A BVH over the bounding boxes of `bounds`: its nodes and the indices
-/// into `bounds` its leaves point to (both empty for no bound). O(n log n).
-fn bvh_over(bounds: &[Bound]) -> (Vec<obvhs::bvh2::node::Bvh2Node>, Vec<u32>) {
-    if bounds.is_empty() {
-        return (Vec::new(), Vec::new());
+/// The buckets of `model` at `spacing` (see the module docs): LoDs
+/// ascending, each distinct, the first LoD 0.
+fn buckets(model: &MtsModel, spacing: f32) -> Vec<Bucket> {
+    let full = model.triangle_count(0) as f64;
+    let mut out: Vec<Bucket> = Vec::new();
+    let mut budget = full;
+    loop {
+        let lod = model.lod_for_triangles(budget.floor() as usize) as u32;
+        if out.last().is_none_or(|b| b.lod < lod) {
+            out.push(Bucket {
+                lod,
+                triangles: model.triangle_count(lod as usize) as u32,
+                buffer: None,
+                len: 0,
+                users: 0,
+                idle: 0,
+                first: 0,
+                placed: 0,
+            });
+        }
+        if lod as usize == model.max_lod() || budget < 1.0 {
+            break;
+        }
+        budget *= 1.0 - f64::from(spacing);
     }
-    let boxes: Vec<obvhs::aabb::Aabb> = bounds
-        .iter()
-        .map(|b| {
-            let r = Vec3::splat(b.radius);
-            obvhs::aabb::Aabb::new((b.centre - r).into(), (b.centre + r).into())
-        })
-        .collect();
-    let mut build_time = std::time::Duration::ZERO;
-    let bvh = obvhs::bvh2::builder::build_bvh2(
-        &boxes,
-        obvhs::BvhBuildParams::fast_build(),
-        &mut build_time,
-    );
-    (bvh.nodes, bvh.primitive_indices)
+    out
 }
 
-/// The world-space bound of a model's `local` bound under `transform`
-/// (the largest axis scale bounds a uniform or non-uniform scale).
-fn place(local: Bound, transform: Mat4) -> Result<Bound> {
+/// A new index buffer holding `indices` (restart value `u32::MAX`) in
+/// `format`, and the bytes written (4-byte aligned: a `u16` buffer of an
+/// odd count ends with a restart).
+fn index_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    format: wgpu::IndexFormat,
+    indices: &[u32],
+    scratch: &mut Vec<u16>,
+) -> Result<(wgpu::Buffer, usize)> {
+    let size = match format {
+        wgpu::IndexFormat::Uint16 => 2 * ((indices.len() as u64 + 1) & !1),
+        wgpu::IndexFormat::Uint32 => 4 * indices.len() as u64,
+    }
+    .max(4);
+    let max = device.limits().max_buffer_size;
+    if size > max {
+        return Err(Error::Gpu(format!(
+            "a {size}-byte index buffer is above the device's max_buffer_size {max}"
+        )));
+    }
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("mts scene bucket"),
+        size,
+        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bytes = if indices.is_empty() {
+        0
+    } else {
+        write_index_range(
+            queue,
+            &buffer,
+            format,
+            indices,
+            0..indices.len(),
+            0,
+            scratch,
+        )
+    };
+    Ok((buffer, bytes))
+}
+
+/// The box around a bound.
+fn aabb(b: Bound) -> obvhs::aabb::Aabb {
+    let r = Vec3::splat(b.radius);
+    obvhs::aabb::Aabb::new((b.centre - r).into(), (b.centre + r).into())
+}
+
+/// The world-space bound of a model's `local` bound under `transform`, and
+/// the transform's largest axis scale (which bounds a uniform or
+/// non-uniform scale).
+fn place(local: Bound, transform: Mat4) -> Result<(Bound, f32)> {
     let scale = [transform.x_axis, transform.y_axis, transform.z_axis]
         .iter()
         .map(|c| c.truncate().length())
@@ -559,138 +872,38 @@ fn place(local: Bound, transform: Mat4) -> Result<Bound> {
         centre: transform.transform_point3(local.centre),
         radius: local.radius * scale,
     };
-    if !(bound.centre.is_finite() && bound.radius.is_finite()) {
+    if !(bound.centre.is_finite() && bound.radius.is_finite() && scale > 0.0) {
         return Err(Error::InvalidArgument(format!(
-            "an instance's bounds are not finite in f32 (centre {}, radius {})",
+            "an instance's bounds are not finite in f32, or its scale is 0 (centre {}, radius {})",
             bound.centre, bound.radius
         )));
     }
-    Ok(bound)
+    Ok((bound, scale))
 }
 
-fn index_size(renderer: &StripRenderer) -> u64 {
-    match renderer.index_format() {
-        wgpu::IndexFormat::Uint16 => 2,
-        wgpu::IndexFormat::Uint32 => 4,
-    }
+/// A BVH over `boxes` (obvhs' fast build, up to 8 instances a leaf).
+/// O(n log n).
+fn build_bvh(boxes: &[obvhs::aabb::Aabb]) -> obvhs::bvh2::Bvh2 {
+    let mut build_time = std::time::Duration::ZERO;
+    obvhs::bvh2::builder::build_bvh2(boxes, obvhs::BvhBuildParams::fast_build(), &mut build_time)
 }
 
-/// An index buffer of `slots` regions of `region` indices and a transform
-/// buffer of `slots` instances.
-fn buffers(
-    device: &wgpu::Device,
-    renderer: &StripRenderer,
-    region: usize,
-    slots: usize,
-) -> Result<(wgpu::Buffer, wgpu::Buffer)> {
-    let bytes = (slots as u64)
-        .saturating_mul(region as u64)
-        .saturating_mul(index_size(renderer));
-    let max = device.limits().max_buffer_size;
-    if bytes > max {
-        return Err(Error::Gpu(format!(
-            "{slots} instances need a {bytes}-byte index buffer, above the device's \
-             max_buffer_size {max}; use fewer instances or a smaller model"
-        )));
-    }
-    let index_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("mts scene indices"),
-        size: bytes,
-        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let instance_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("mts scene instances"),
-        size: slots as u64 * INSTANCE_BYTES,
-        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    Ok((index_buffer, instance_buffer))
-}
-
-/// Uploads the transforms of `entry`'s moved slots: each run of
-/// consecutive slots in one write (a host moving every instance each frame
-/// sends one buffer, not one write per instance), each slot once however
-/// often it moved. Clears the list.
-fn upload_transforms(queue: &wgpu::Queue, entry: &mut ModelEntry<'_>, scratch: &mut Vec<f32>) {
-    let moved = &mut entry.moved;
-    moved.sort_unstable();
-    moved.dedup();
-    let mut i = 0;
-    while i < moved.len() {
-        let first = moved[i];
-        scratch.clear();
-        let mut next = first;
-        while i < moved.len() && moved[i] == next {
-            let m = entry.slots[next as usize]
-                .as_ref()
-                .map_or(Mat4::ZERO, |slot| slot.transform);
-            scratch.extend_from_slice(&m.to_cols_array());
-            next += 1;
-            i += 1;
+/// Refits `bvh` to the primitives' current bounds: each leaf's box from
+/// its primitives, then the inner nodes bottom-up. O(n).
+fn refit(bvh: &mut obvhs::bvh2::Bvh2, bound: impl Fn(u32) -> Bound) {
+    for n in 0..bvh.nodes.len() {
+        let node = bvh.nodes[n];
+        if !node.is_leaf() {
+            continue;
         }
-        queue.write_buffer(
-            &entry.instance_buffer,
-            u64::from(first) * INSTANCE_BYTES,
-            bytemuck::cast_slice(scratch),
-        );
-    }
-    moved.clear();
-}
-
-/// Grows `entry`'s buffers to hold all its slots (doubling); after a
-/// growth every transform is uploaded and every region written again.
-fn grow(device: &wgpu::Device, entry: &mut ModelEntry<'_>) -> Result<()> {
-    let needed = entry.slots.len();
-    if needed <= entry.capacity {
-        return Ok(());
-    }
-    let capacity = needed.next_power_of_two();
-    let (index_buffer, instance_buffer) = buffers(device, &entry.renderer, entry.region, capacity)?;
-    entry.index_buffer = index_buffer;
-    entry.instance_buffer = instance_buffer;
-    entry.capacity = capacity;
-    entry.moved.clear();
-    for (i, slot) in entry.slots.iter_mut().enumerate() {
-        if let Some(slot) = slot {
-            slot.written = false;
-            entry.moved.push(i as u32);
+        let first = node.first_index as usize;
+        let mut bounds = obvhs::aabb::Aabb::empty();
+        for &p in &bvh.primitive_indices[first..first + node.prim_count as usize] {
+            bounds = bounds.union(&aabb(bound(p)));
         }
+        bvh.nodes[n].set_aabb(bounds);
     }
-    Ok(())
-}
-
-/// Uploads what `ex`'s last `set_lod` changed into the region at `base`,
-/// which holds `held` (an active range) now: the dirty ranges inside the
-/// active range when it did not move, else the whole new active range.
-/// Returns the bytes written.
-fn upload_instance(
-    queue: &wgpu::Queue,
-    buffer: &wgpu::Buffer,
-    format: wgpu::IndexFormat,
-    base: usize,
-    ex: &Extractor<'_>,
-    held: &mut Range<usize>,
-    scratch: &mut Vec<u16>,
-) -> usize {
-    let active = ex.active_range();
-    let source = ex.buffer();
-    if active != *held {
-        *held = active.clone();
-        if active.is_empty() {
-            return 0;
-        }
-        return write_index_range(queue, buffer, format, source, active.clone(), base, scratch);
-    }
-    let mut bytes = 0;
-    for r in ex.dirty_ranges() {
-        let (start, end) = (r.start.max(active.start), r.end.min(active.end));
-        if start < end {
-            let dest = base + (start - active.start);
-            bytes += write_index_range(queue, buffer, format, source, start..end, dest, scratch);
-        }
-    }
-    bytes
+    bvh.refit_all();
 }
 
 /// The six planes (`n · p + d >= 0` inside) of a view-projection matrix
@@ -713,18 +926,18 @@ fn frustum_planes(m: Mat4) -> [Vec4; 6] {
 /// instances are tested by their spheres, so the result is the linear
 /// sphere test's.
 fn cull(
-    nodes: &[obvhs::bvh2::node::Bvh2Node],
-    leaves: &[u32],
-    instances: &[Bound],
+    bvh: Option<&obvhs::bvh2::Bvh2>,
+    bound: impl Fn(u32) -> Bound,
     planes: &[Vec4; 6],
     stack: &mut Vec<u32>,
     visible: &mut Vec<u32>,
 ) {
     visible.clear();
     stack.clear();
-    if nodes.is_empty() {
+    let Some(bvh) = bvh.filter(|b| !b.nodes.is_empty()) else {
         return;
-    }
+    };
+    let (nodes, leaves) = (&bvh.nodes, &bvh.primitive_indices);
     stack.push(0);
     while let Some(n) = stack.pop() {
         let node = &nodes[n as usize];
@@ -735,7 +948,7 @@ fn cull(
         if node.is_leaf() {
             let first = node.first_index as usize;
             for &p in &leaves[first..first + node.prim_count as usize] {
-                let inst = &instances[p as usize];
+                let inst = bound(p);
                 if sphere_in_frustum(planes, inst.centre, inst.radius) {
                     visible.push(p);
                 }
@@ -795,10 +1008,25 @@ mod tests {
                 }
             })
             .collect();
-        let (nodes, leaves) = bvh_over(&instances);
+        let boxes: Vec<_> = instances.iter().map(|&b| aabb(b)).collect();
+        let mut bvh = build_bvh(&boxes);
         let (mut stack, mut visible) = (Vec::new(), Vec::new());
         let mut seen = 0;
-        for k in 0..20u32 {
+        // The same after every instance moved and the BVH was refitted.
+        let moved: Vec<Bound> = instances
+            .iter()
+            .enumerate()
+            .map(|(i, b)| Bound {
+                centre: b.centre
+                    + Vec3::new(hash01(i as u32 + 7) * 9.0, 0.0, -hash01(i as u32) * 9.0),
+                radius: b.radius * (0.5 + hash01(i as u32 + 3)),
+            })
+            .collect();
+        for k in 0..40u32 {
+            let instances = if k < 20 { &instances } else { &moved };
+            if k == 20 {
+                refit(&mut bvh, |p| moved[p as usize]);
+            }
             let eye = Vec3::new(
                 hash01(k) * 90.0,
                 2.0 + hash01(k + 50) * 20.0,
@@ -808,9 +1036,8 @@ mod tests {
             let cam = Camera::looking(eye, target, 1.5, 0.1, 60.0 + 40.0 * hash01(k + 3));
             let planes = frustum_planes(cam.view_proj);
             cull(
-                &nodes,
-                &leaves,
-                &instances,
+                Some(&bvh),
+                |p| instances[p as usize],
                 &planes,
                 &mut stack,
                 &mut visible,
@@ -824,7 +1051,7 @@ mod tests {
             assert_eq!(visible, linear, "camera {k}");
             seen += visible.len();
         }
-        assert!(seen > 500, "the cameras see something ({seen})");
+        assert!(seen > 1000, "the cameras see something ({seen})");
     }
 
     #[test]
@@ -861,5 +1088,45 @@ mod tests {
             Vec3::new(50.0, 0.0, -10.0) - unit,
             Vec3::new(50.0, 0.0, -10.0) + unit
         ));
+    }
+
+    #[test]
+    fn buckets_are_a_geometric_series_of_triangle_counts() {
+        use mts::mesh::generate::Generated;
+        let mesh: mts::Mesh = "torus:20k".parse::<Generated>().unwrap().build();
+        let (model, _, _) = mts::model::build_from_mesh(
+            &mesh,
+            &mts::model::PipelineOptions::default(),
+            &mut |_, _| {},
+        );
+        let full = model.triangle_count(0) as f64;
+        for spacing in [0.1f32, 0.3] {
+            let b = buckets(&model, spacing);
+            assert_eq!(b[0].lod, 0);
+            assert_eq!(b.last().unwrap().lod as usize, model.max_lod());
+            for (i, w) in b.windows(2).enumerate() {
+                assert!(w[0].lod < w[1].lod);
+                // Each bucket is the finest LoD within its budget: the
+                // next finer LoD has more triangles than the budget that
+                // chose it, so a step never drops far more than `spacing`.
+                assert_eq!(
+                    w[1].triangles as usize,
+                    model.triangle_count(w[1].lod as usize)
+                );
+                let ratio = f64::from(w[1].triangles) / f64::from(w[0].triangles);
+                assert!(ratio < 1.0, "{i}: {ratio}");
+            }
+            let sum: f64 = b.iter().map(|b| f64::from(b.triangles)).sum();
+            // At most the geometric series' sum (plus the last buckets,
+            // where LoDs are fewer than budgets).
+            assert!(
+                sum <= full / f64::from(spacing) + 1.0,
+                "{spacing}: {sum} for {full}"
+            );
+            assert!(
+                sum >= full / f64::from(spacing) * 0.8,
+                "{spacing}: {sum} for {full}"
+            );
+        }
     }
 }

@@ -432,7 +432,7 @@ fn scene_image(
     camera: &Camera,
 ) -> (Image, FrameStats) {
     let stats = scene
-        .update(&gpu.device, &gpu.queue, camera, HEIGHT as f32)
+        .update(&gpu.device, &gpu.queue, camera, HEIGHT as f32, 1.0)
         .unwrap();
     let image = target
         .render_image(&gpu.device, &gpu.queue, |pass| scene.draw(pass))
@@ -448,16 +448,20 @@ fn grid_of<'m>(
     radius: f32,
     count: usize,
 ) -> Vec<InstanceId> {
-    let side = (count as f64).sqrt().ceil() as usize;
     (0..count)
         .map(|i| {
-            let at = glam::Vec3::new((i % side) as f32, 0.0, (i / side) as f32) * 5.0 * radius;
-            let turn = glam::Mat4::from_rotation_y(i as f32 * 0.7);
             scene
-                .add_instance(model, glam::Mat4::from_translation(at) * turn)
+                .add_instance(model, grid_transform(i, count, radius))
                 .unwrap()
         })
         .collect()
+}
+
+/// The transform of instance `i` of `count` in [`grid_of`].
+fn grid_transform(i: usize, count: usize, radius: f32) -> glam::Mat4 {
+    let side = (count as f64).sqrt().ceil() as usize;
+    let at = glam::Vec3::new((i % side) as f32, 0.0, (i / side) as f32) * 5.0 * radius;
+    glam::Mat4::from_translation(at) * glam::Mat4::from_rotation_y(i as f32 * 0.7)
 }
 
 /// A camera above the corner `lo` of a field looking across it to `hi`.
@@ -506,7 +510,13 @@ fn scene_culls_and_updates_like_a_fresh_scene() {
         0.1,
         1e4,
     );
-    assert_eq!(scene.update(d, q, &away, HEIGHT as f32).unwrap().visible, 0);
+    assert_eq!(
+        scene
+            .update(d, q, &away, HEIGHT as f32, 1.0)
+            .unwrap()
+            .visible,
+        0
+    );
 
     // Across the field from a corner: every instance whose centre projects
     // inside the view is drawn, none behind the camera is, nearer ones get
@@ -516,7 +526,7 @@ fn scene_culls_and_updates_like_a_fresh_scene() {
     let visible = scene.visible().to_vec();
     eprintln!(
         "scene: {} of 100 instances visible, {} triangles, {} indices sent",
-        stats.visible, stats.triangles, stats.indices_sent
+        stats.visible, stats.triangles, stats.indices_drawn
     );
     assert!(
         0 < stats.visible && stats.visible < 100,
@@ -557,6 +567,9 @@ fn scene_culls_and_updates_like_a_fresh_scene() {
         FrameStats {
             lod_changes: fresh_stats.lod_changes,
             upload_bytes: fresh_stats.upload_bytes,
+            extractions: fresh_stats.extractions,
+            evictions: fresh_stats.evictions,
+            bvh: fresh_stats.bvh,
             ..stats
         }
     );
@@ -666,7 +679,7 @@ fn instanced_scene_on_gl_covers_what_vulkan_covers() {
         let ids = grid_of(&mut scene, id, radius, 50);
         let far = scene.bounds_of(ids[49]).unwrap().0;
         let camera = across(glam::Vec3::ZERO, far, target.aspect());
-        let stats = scene.update(d, q, &camera, HEIGHT as f32).unwrap();
+        let stats = scene.update(d, q, &camera, HEIGHT as f32, 1.0).unwrap();
         assert!(
             stats.visible > 10 && stats.lod_changes == stats.visible,
             "{stats:?}"
@@ -707,4 +720,106 @@ fn readback_beyond_the_device_limit_is_an_error() {
         Err(Error::InvalidArgument(m)) => assert!(m.contains("max_buffer_size"), "{m}"),
         other => panic!("expected an InvalidArgument, got {:?}", other.map(|_| ())),
     }
+}
+
+/// Issue 22: instances share their LoD bucket's buffer, each drawing the
+/// coarsest bucket at least as fine as the LoD its projected error allows;
+/// moving instances refits the BVH and draws what a fresh scene draws;
+/// buckets nobody uses are freed after `KEEP_UPDATES` updates; 0 pixels is
+/// full detail.
+#[test]
+fn instances_share_buckets_chosen_by_screen_space_error() {
+    use mts_render::scene::{BvhUpdate, KEEP_UPDATES};
+    let Some(gpu) = gpu() else { return };
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let config = RendererConfig::headless(StripMode::Restart);
+    let target = HeadlessTarget::new(d, WIDTH, HEIGHT).unwrap();
+    let mesh: Mesh = "torus:4k".parse::<Generated>().unwrap().build();
+    let model = model_of(&mesh);
+    let mut scene = InstancedScene::new(&config);
+    let id = scene.add_model(d, q, &model).unwrap();
+    let radius = mesh.diagonal() * 0.5;
+    let ids = grid_of(&mut scene, id, radius, 400);
+    let far = scene.bounds_of(ids[399]).unwrap().0;
+    let camera = across(glam::Vec3::ZERO, far, target.aspect());
+    let (_, stats) = scene_image(&gpu, &target, &mut scene, &camera);
+    assert_eq!(stats.bvh, BvhUpdate::Rebuilt);
+    assert!(stats.visible > 50, "{stats:?}");
+    // Fewer buffers than visible instances: they are shared.
+    let memory = scene.memory();
+    assert_eq!(memory.buffers, stats.draws);
+    assert!(memory.buffers * 4 < stats.visible, "{memory:?} {stats:?}");
+    assert!(memory.cpu_bytes_per_instance() <= 256, "{memory:?}");
+    // Each visible instance: its wanted LoD's error projects within one
+    // pixel (the next coarser one's does not), and its bucket is at least
+    // as fine, within 10% more triangles than the next coarser bucket
+    // would have.
+    let collapses = model.collapses();
+    let row_y = camera.view_proj.row(1).truncate().length();
+    let px_at_1 = row_y * 0.5 * HEIGHT as f32;
+    let mut lods = std::collections::BTreeSet::new();
+    for &i in scene.visible() {
+        let (centre, r) = scene.bounds_of(i).unwrap();
+        let depth = camera.view_proj.row(3).dot(centre.extend(1.0));
+        let ppu = px_at_1 / (depth - r).max(1e-9);
+        let wanted = scene.wanted_lod_of(i).unwrap();
+        let pixels = |lod: usize| collapses.error(lod) * mesh.diagonal() * ppu;
+        assert!(pixels(wanted) <= 1.0 + 1e-4, "{wanted}: {}", pixels(wanted));
+        if wanted < model.max_lod() {
+            assert!(
+                pixels(wanted + 1) > 1.0 - 1e-4,
+                "{wanted} is not the coarsest"
+            );
+        }
+        let drawn = scene.lod_of(i).unwrap();
+        assert!(drawn <= wanted, "bucket LoD {drawn} coarser than {wanted}");
+        lods.insert(drawn);
+    }
+    assert!(
+        lods.len() > 2,
+        "nearer and farther instances differ: {lods:?}"
+    );
+
+    // Moving every instance a little: refitted, and drawn as a fresh scene
+    // in the same state draws.
+    let lift = glam::Mat4::from_translation(glam::Vec3::new(0.0, 0.3 * radius, 0.0));
+    let mut fresh = InstancedScene::new(&config);
+    let fresh_id = fresh.add_model(d, q, &model).unwrap();
+    let fresh_ids = grid_of(&mut fresh, fresh_id, radius, 400);
+    for (i, (&a, &b)) in ids.iter().zip(&fresh_ids).enumerate() {
+        let moved = lift * grid_transform(i, 400, radius);
+        scene.set_transform(a, moved).unwrap();
+        fresh.set_transform(b, moved).unwrap();
+    }
+    let (image, stats) = scene_image(&gpu, &target, &mut scene, &camera);
+    assert_eq!(stats.bvh, BvhUpdate::Refitted);
+    let (expected, _) = scene_image(&gpu, &target, &mut fresh, &camera);
+    assert_eq!(difference(&image, &expected), (0, 0));
+    assert!(image.foreground_pixels() > 2_000);
+
+    // 0 pixels: every visible instance at full detail, one bucket.
+    let stats = scene.update(d, q, &camera, HEIGHT as f32, 0.0).unwrap();
+    assert_eq!(stats.triangles, stats.triangles_full_detail);
+    assert_eq!(stats.draws, 1);
+    assert!(scene.visible().iter().all(|&i| scene.lod_of(i) == Some(0)));
+
+    // Looking away: nothing drawn; the buckets go after KEEP_UPDATES.
+    let away = Camera::looking(
+        glam::Vec3::new(0.0, 0.0, -10.0 * radius),
+        glam::Vec3::new(0.0, 0.0, -100.0 * radius),
+        target.aspect(),
+        0.1,
+        10.0 * radius,
+    );
+    let mut evicted = 0;
+    for k in 0..=KEEP_UPDATES {
+        let stats = scene.update(d, q, &away, HEIGHT as f32, 1.0).unwrap();
+        assert_eq!(stats.visible, 0);
+        evicted += stats.evictions;
+        if k < KEEP_UPDATES {
+            assert!(scene.memory().buffers > 0, "freed too early ({k})");
+        }
+    }
+    assert_eq!(scene.memory().buffers, 0);
+    assert!(evicted > 2, "{evicted}");
 }
