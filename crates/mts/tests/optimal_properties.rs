@@ -52,7 +52,9 @@ fn check_lods(
 ) {
     c.validate().unwrap();
     let (borders0, seams0) = borders_and_seam_points(mesh);
-    let all = c.properties(mesh).expect("created vertices have properties");
+    let all = c
+        .properties(mesh)
+        .expect("created vertices have properties");
     let total = mesh.vertex_count() + c.appended().len();
     all.check_counts(total).unwrap();
     for lod in lods {
@@ -85,7 +87,10 @@ fn check_lods(
         if let (Some(uvs), Some(all_uvs)) = (&p.uvs, &all.uvs) {
             for (&old, &new) in &at_vertex {
                 assert_eq!(uvs[new as usize], all_uvs[old as usize]);
-                assert_eq!(rep[old as usize], old, "drawn vertices are their own representatives");
+                assert_eq!(
+                    rep[old as usize], old,
+                    "drawn vertices are their own representatives"
+                );
             }
         }
         // No tear: the drawn vertices that the vertices of one input point
@@ -95,12 +100,17 @@ fn check_lods(
             let r = rep[v as usize];
             if at_vertex.contains_key(&r) {
                 let now = all.position_id(r);
-                let was = *point_of.entry(mesh.properties.position_id(v)).or_insert(now);
+                let was = *point_of
+                    .entry(mesh.properties.position_id(v))
+                    .or_insert(now);
                 assert_eq!(was, now, "{name} at {lod}: a point tore");
             }
         }
         let (borders, seams) = borders_and_seam_points(&at);
-        assert!(seams <= seams0, "{name} at {lod}: {seams} seam points, {seams0} before");
+        assert!(
+            seams <= seams0,
+            "{name} at {lod}: {seams} seam points, {seams0} before"
+        );
         // Open random surfaces (holes, flipped and doubled triangles) may
         // change their borders; closed or clean models keep theirs.
         assert!(
@@ -199,8 +209,8 @@ fn a_mesh_without_seams_creates_one_vertex_per_step() {
     check_created_properties(&mesh, &c);
 }
 
-/// The baselines and the MTS model's consumers that need endpoint
-/// placement refuse these sequences with an error.
+/// The baselines that need endpoint placement refuse these sequences with
+/// an error, and the MTS model says it cannot hold them.
 #[test]
 fn endpoint_only_consumers_refuse_cleanly() {
     let g: mts::mesh::generate::Generated = "torus:500".parse().unwrap();
@@ -208,6 +218,9 @@ fn endpoint_only_consumers_refuse_cleanly() {
     let c = simplify(&mesh, &optimal()).collapses;
     assert!(mts::baselines::pm::ProgressiveMesh::new(&mesh, &c).is_err());
     assert!(mts::baselines::multilevel::MultilevelMesh::new(&mesh, &c).is_err());
+    assert!(!mts::model::can_build(&c));
+    let plain = simplify(&g.build(), &optimal()).collapses;
+    assert!(mts::model::can_build(&plain));
 }
 
 /// `surface` with every triangle given a chart (by `charts`), each

@@ -710,7 +710,10 @@ impl<P: Place> Contractor<P> {
                 }
             }
             if let Some(attributes) = &mut self.attributes {
-                let props = self.properties.as_ref().expect("optimal placement keeps properties");
+                let props = self
+                    .properties
+                    .as_ref()
+                    .expect("optimal placement keeps properties");
                 for (j, &(va, vb)) in self.seam_pairs.iter().enumerate() {
                     attributes.create((first_created + j) as u32, va, vb, props);
                 }
