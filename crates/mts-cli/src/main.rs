@@ -884,6 +884,13 @@ fn build(args: &BuildArgs) -> Result<()> {
     let (name, mesh, _) = args.source.load()?;
     let load = started.elapsed();
     let options = args.pipeline_options();
+    if args.optimal && !mesh.properties.is_empty() {
+        bail!(
+            "{name}: the MTS model cannot hold the vertices optimal placement creates with \
+             properties; drop --optimal or --properties (`mts simplify --optimal --properties` \
+             writes such levels)"
+        );
+    }
     let (model, _, t) = build_with_bar(&mesh, &options);
     let bytes = model.to_bytes();
     std::fs::write(&args.output, &bytes)

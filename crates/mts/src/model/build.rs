@@ -116,7 +116,11 @@ pub const SEGMENT_DROP: f64 = 0.5;
 ///
 /// # Panics
 /// If `strips` or `collapses` were not made for `mesh` (different vertex
-/// counts), or the strips do not index `mesh`'s vertices.
+/// counts), or the strips do not index `mesh`'s vertices, or `collapses`
+/// creates vertices with properties (optimal placement on a mesh with
+/// properties: the model and its file hold one created vertex per step and
+/// the input vertices' properties only; check
+/// [`can_build`] first).
 #[must_use]
 pub fn build(
     mesh: &Mesh,
@@ -125,6 +129,16 @@ pub fn build(
     options: &BuildOptions,
 ) -> MtsModel {
     build_with_progress(mesh, strips, collapses, options, &mut |_, _| {})
+}
+
+/// Whether [`build`] accepts `collapses`: not when optimal placement
+/// created vertices with properties (its file and the renderer's vertex
+/// buffer hold the input vertices' properties only, and one created vertex
+/// per step).
+#[must_use]
+pub fn can_build(collapses: &Collapses) -> bool {
+    !collapses.is_optimal_placement()
+        || (!collapses.has_companions() && collapses.created_properties().is_empty())
 }
 
 /// [`build`], calling `progress(lods_done, max_lod)` as LoDs are replayed.
@@ -148,6 +162,10 @@ pub fn build_with_progress(
         collapses.vertex_count(),
         mesh.vertex_count(),
         "collapses of another mesh"
+    );
+    assert!(
+        can_build(collapses),
+        "the MTS model cannot hold vertices created with properties (optimal placement on a mesh with properties)"
     );
     let max_lod = collapses.max_lod() as u32;
     let mut positions = mesh.positions.clone();

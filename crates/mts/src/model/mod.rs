@@ -35,7 +35,8 @@ pub mod sequence;
 mod verify;
 
 pub use build::{
-    build, build_with_progress, BuildOptions, DEFAULT_BAND_SLACK, MIN_BAND_DROP, MIN_BAND_SLACK,
+    build, build_with_progress, can_build, BuildOptions, DEFAULT_BAND_SLACK, MIN_BAND_DROP,
+    MIN_BAND_SLACK,
 };
 pub use extract::{Extractor, Update};
 pub use pipeline::{build_from_mesh, PipelineOptions, PipelineTimings};

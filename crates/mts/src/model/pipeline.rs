@@ -40,6 +40,10 @@ pub struct PipelineTimings {
 ///
 /// Cost: that of the three stages; peak memory about the sum of their
 /// outputs plus the construction's working arrays.
+///
+/// # Panics
+/// As [`super::build`]: optimal placement on a mesh with properties is
+/// refused ([`super::can_build`]).
 #[must_use]
 pub fn build_from_mesh(
     mesh: &Mesh,

@@ -15,9 +15,15 @@
 //! of the seam, all at that LoD. The step's [`Collapse`] holds the first
 //! move and [`Collapses::moves`] all of them; the others are the step's
 //! *companions*.
+//!
+//! With optimal placement a step creates one vertex per pair it moves
+//! (its [`Collapse`] and each companion): both vertices of the pair move
+//! onto it, so a seamed point becomes one new point with as many vertices
+//! as the pair had sides. The created vertices follow the input's in step
+//! order, and [`Collapses::created_properties`] holds their properties.
 
 use crate::error::ensure;
-use crate::mesh::{is_degenerate, Mesh};
+use crate::mesh::{is_degenerate, Mesh, Properties};
 use glam::Vec3;
 
 /// One contraction: `removed` is replaced by `kept` from then on.
@@ -27,7 +33,7 @@ pub struct Collapse {
     pub removed: u32,
     /// The vertex that represents it from this step on. In optimal-placement
     /// sequences it is the other endpoint, and both endpoints are replaced
-    /// by the vertex this step creates ([`Collapses::target`]).
+    /// by the first vertex this step creates ([`Collapses::target`]).
     pub kept: u32,
     /// Error of the mesh after this step, relative to the bounding-box
     /// diagonal of the input: the running maximum over the contractions so
@@ -43,11 +49,13 @@ pub struct Collapse {
 ///
 /// Invariants (checked by [`Collapses::validate`]): a vertex is removed at
 /// most once and never used as `kept` after its removal (companion moves
-/// included); companions exist only with endpoint placement; the
-/// triangle-count
-/// table has `max_lod() + 1` non-increasing entries starting at the input's
-/// triangle count; errors are finite and non-decreasing; the forest links
-/// agree with the steps.
+/// included); with optimal placement there is one created vertex per pair
+/// moved (a step and each companion), all of one step at one position, each
+/// created after the vertices its step moves, and their properties (when
+/// present) one per created vertex, finite, normals unit or zero, colours in
+/// 0..=1; the triangle-count table has `max_lod() + 1` non-increasing
+/// entries starting at the input's triangle count; errors are finite and
+/// non-decreasing; the forest links agree with the steps.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Collapses {
     /// Vertices of the input mesh.
@@ -56,14 +64,23 @@ pub struct Collapses {
     pub(crate) steps: Vec<Collapse>,
     /// Triangles (not degenerate) at each LoD, `max_lod + 1` entries.
     pub(crate) triangle_counts: Vec<u32>,
-    /// Optimal-placement mode: the position of the vertex created by each
-    /// step (one per step); empty when contractions keep an endpoint.
+    /// Optimal-placement mode: the position of each created vertex, in
+    /// step order (one per pair a step moves, see
+    /// [`Collapses::created_start`]); empty when contractions keep an
+    /// endpoint.
     pub(crate) appended: Vec<Vec3>,
+    /// Properties of the created vertices (streams only, one entry per
+    /// entry of `appended`); empty when the input has none.
+    pub(crate) created_properties: Properties,
     /// Companion moves `(removed, kept)` of every step, in step order, and
     /// where each step's start (`max_lod() + 1` offsets); both empty when
     /// no step has one.
     pub(crate) companions: Vec<(u32, u32)>,
     pub(crate) companion_start: Vec<u32>,
+    /// Optimal placement: the first created vertex of each step, less
+    /// `vertex_count` (`max_lod() + 1` offsets, so step `i` creates
+    /// `created_start[i + 1] - created_start[i]` vertices); empty otherwise.
+    pub(crate) created_start: Vec<u32>,
     /// Forest: for each vertex (input and appended) its representative once
     /// it is removed, and the LoD from which that link holds (`u32::MAX`
     /// for a vertex never removed).
@@ -99,6 +116,30 @@ impl Collapses {
         appended: Vec<Vec3>,
         companions: Vec<Vec<(u32, u32)>>,
     ) -> Collapses {
+        Collapses::with_created_properties(
+            vertex_count,
+            steps,
+            triangle_counts,
+            appended,
+            companions,
+            Properties::default(),
+        )
+    }
+
+    /// [`Collapses::with_companions`] with the properties of the created
+    /// vertices (optimal placement on a mesh with properties; streams only,
+    /// one entry per created vertex). In optimal placement each step
+    /// creates one vertex per pair it moves, so `appended` then holds
+    /// `steps.len()` plus the companions' count.
+    #[must_use]
+    pub(crate) fn with_created_properties(
+        vertex_count: usize,
+        steps: Vec<Collapse>,
+        triangle_counts: Vec<u32>,
+        appended: Vec<Vec3>,
+        companions: Vec<Vec<(u32, u32)>>,
+        created_properties: Properties,
+    ) -> Collapses {
         let (mut flat, mut companion_start) = (Vec::new(), Vec::new());
         if companions.iter().any(|c| !c.is_empty()) {
             companion_start.push(0);
@@ -107,28 +148,38 @@ impl Collapses {
                 companion_start.push(flat.len() as u32);
             }
         }
+        let optimal = !appended.is_empty();
+        let created_start: Vec<u32> = if optimal {
+            (0..=steps.len())
+                .map(|i| i as u32 + companion_start.get(i).copied().unwrap_or(0))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let total = vertex_count + appended.len();
         let mut parent: Vec<u32> = (0..total as u32).collect();
         let mut parent_from_lod = vec![u32::MAX; total];
-        let optimal = !appended.is_empty();
         for (i, s) in steps.iter().enumerate() {
             let lod = i as u32 + 1;
-            let target = if optimal {
-                (vertex_count + i) as u32
-            } else {
-                s.kept
+            let step_companions = match companion_start.get(i..i + 2) {
+                Some(w) => &flat[w[0] as usize..w[1] as usize],
+                None => &[],
             };
-            parent[s.removed as usize] = target;
-            parent_from_lod[s.removed as usize] = lod;
-            if let Some(w) = companion_start.get(i..i + 2) {
-                for &(r, k) in &flat[w[0] as usize..w[1] as usize] {
-                    parent[r as usize] = k;
+            let pairs = std::iter::once((s.removed, s.kept)).chain(step_companions.iter().copied());
+            for (j, (r, k)) in pairs.enumerate() {
+                if optimal {
+                    // Out of range for a broken table: `validate` reports it.
+                    let c = (vertex_count + created_start[i] as usize + j).min(total - 1) as u32;
+                    for v in [r, k] {
+                        if let Some(slot) = parent.get_mut(v as usize) {
+                            *slot = c;
+                            parent_from_lod[v as usize] = lod;
+                        }
+                    }
+                } else if let Some(slot) = parent.get_mut(r as usize) {
+                    *slot = k;
                     parent_from_lod[r as usize] = lod;
                 }
-            }
-            if optimal {
-                parent[s.kept as usize] = target;
-                parent_from_lod[s.kept as usize] = lod;
             }
         }
         let c = Collapses {
@@ -136,8 +187,10 @@ impl Collapses {
             steps,
             triangle_counts,
             appended,
+            created_properties,
             companions: flat,
             companion_start,
+            created_start,
             parent,
             parent_from_lod,
         };
@@ -146,31 +199,55 @@ impl Collapses {
     }
 
     /// The vertex that replaces step `i`'s endpoints: `kept`, or in
-    /// optimal-placement mode the vertex the step creates
-    /// (`vertex_count() + i`).
+    /// optimal-placement mode the first vertex the step creates
+    /// (`vertex_count() + i` when no step has companions).
     #[must_use]
     pub fn target(&self, i: usize) -> u32 {
         if self.appended.is_empty() {
             self.steps[i].kept
         } else {
-            (self.vertex_count + i) as u32
+            (self.vertex_count + self.created_start[i] as usize) as u32
         }
     }
 
-    /// Every vertex move of step `i` as `(from, to)`: `removed → kept` and
-    /// its companions, or in optimal placement both endpoints onto the
-    /// created vertex. A LoD change applies all of them at once.
-    pub fn moves(&self, i: usize) -> impl Iterator<Item = (u32, u32)> + '_ {
+    /// The vertices step `i` creates (empty with endpoint placement): the
+    /// `j`-th replaces the step's `j`-th pair (its [`Collapse`], then its
+    /// companions).
+    #[must_use]
+    pub fn created(&self, i: usize) -> std::ops::Range<u32> {
+        match self.created_start.get(i..i + 2) {
+            Some(w) => {
+                let n = self.vertex_count as u32;
+                n + w[0]..n + w[1]
+            }
+            None => 0..0,
+        }
+    }
+
+    /// The pairs step `i` moves: its [`Collapse`] as `(removed, kept)`,
+    /// then its companions.
+    fn pairs(&self, i: usize) -> impl Iterator<Item = (u32, u32)> + '_ {
         let s = self.steps[i];
-        let target = self.target(i);
-        let kept = self.is_optimal_placement().then_some((s.kept, target));
         let companions = match self.companion_start.get(i..i + 2) {
             Some(w) => &self.companions[w[0] as usize..w[1] as usize],
             None => &[],
         };
-        std::iter::once((s.removed, target))
-            .chain(kept)
-            .chain(companions.iter().copied())
+        std::iter::once((s.removed, s.kept)).chain(companions.iter().copied())
+    }
+
+    /// Every vertex move of step `i` as `(from, to)`: `removed → kept` and
+    /// its companions, or in optimal placement both vertices of each pair
+    /// onto the vertex created for it. A LoD change applies all of them at
+    /// once.
+    pub fn moves(&self, i: usize) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let first = self.is_optimal_placement().then(|| self.target(i));
+        self.pairs(i).enumerate().flat_map(move |(j, (r, k))| {
+            let both = match first {
+                Some(c) => [Some((r, c + j as u32)), Some((k, c + j as u32))],
+                None => [Some((r, k)), None],
+            };
+            both.into_iter().flatten()
+        })
     }
 
     /// Whether any step moves more than one vertex of a point (the mesh
@@ -206,10 +283,66 @@ impl Collapses {
     }
 
     /// Positions of the vertices created by optimal placement (vertex
-    /// `vertex_count() + i` is created by step `i`); empty otherwise.
+    /// `vertex_count() + i` is `appended()[i]`, created by the step whose
+    /// [`Collapses::created`] holds it); empty otherwise.
     #[must_use]
     pub fn appended(&self) -> &[Vec3] {
         &self.appended
+    }
+
+    /// Properties of the created vertices (one entry per
+    /// [`Collapses::appended`] in each stream); empty when the input has
+    /// none or placement keeps endpoints.
+    #[must_use]
+    pub fn created_properties(&self) -> &Properties {
+        &self.created_properties
+    }
+
+    /// Properties of every vertex, the input's then the created ones, with
+    /// position ids (the created vertices of one step share a new point)
+    /// when the input has them; `None` when the input has properties the
+    /// created vertices lack (a sequence computed without them).
+    ///
+    /// # Panics
+    /// If `mesh` is not the mesh the sequence was computed from.
+    #[must_use]
+    pub fn properties(&self, mesh: &Mesh) -> Option<Properties> {
+        assert_eq!(
+            mesh.vertex_count(),
+            self.vertex_count,
+            "Collapses used with another mesh"
+        );
+        let p = &mesh.properties;
+        if self.appended.is_empty() {
+            return Some(p.clone());
+        }
+        let c = &self.created_properties;
+        if p.normals.is_some() != c.normals.is_some()
+            || p.uvs.is_some() != c.uvs.is_some()
+            || p.colors.is_some() != c.colors.is_some()
+        {
+            return None;
+        }
+        fn join<T: Copy>(a: &Option<Vec<T>>, b: &Option<Vec<T>>) -> Option<Vec<T>> {
+            Some(a.as_ref()?.iter().chain(b.as_ref()?).copied().collect())
+        }
+        let position_ids = if p.position_ids.is_empty() {
+            Vec::new()
+        } else {
+            let points = p.position_ids.iter().max().map_or(0, |&m| m + 1);
+            let mut ids = p.position_ids.clone();
+            for i in 0..self.max_lod() {
+                ids.extend(self.created(i).map(|_| points + i as u32));
+            }
+            ids
+        };
+        Some(Properties {
+            normals: join(&p.normals, &c.normals),
+            uvs: join(&p.uvs, &c.uvs),
+            colors: join(&p.colors, &c.colors),
+            position_ids,
+            texture: p.texture.clone(),
+        })
     }
 
     /// Triangle count at LoD `lod` (degenerate triangles not counted).
@@ -316,8 +449,9 @@ impl Collapses {
     }
 
     /// The mesh at `lod` as a standalone [`Mesh`]: [`Collapses::triangles_at`]
-    /// with unreferenced vertices dropped (order kept), for export and error
-    /// measurement.
+    /// with unreferenced vertices dropped (order kept), with their
+    /// properties ([`Collapses::properties`]; none when the created vertices
+    /// lack the input's), for export and error measurement.
     #[must_use]
     pub fn mesh_at(&self, mesh: &Mesh, lod: usize) -> Mesh {
         let triangles = self.triangles_at(mesh, lod);
@@ -328,10 +462,8 @@ impl Collapses {
             .copied()
             .collect();
         let (mut out, order) = compact(&all, &triangles);
-        if self.appended.is_empty() {
-            // Endpoint placement: every vertex is an input vertex, with its
-            // input properties.
-            out.properties = mesh.properties.gather(&order);
+        if let Some(p) = self.properties(mesh) {
+            out.properties = p.gather(&order);
         }
         out
     }
@@ -342,6 +474,7 @@ impl Collapses {
     /// [`crate::Invalid`] naming the first broken invariant.
     pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
         let total = self.vertex_count + self.appended.len();
+        let optimal = self.is_optimal_placement();
         ensure!(
             "Collapses",
             self.triangle_counts.len() == self.steps.len() + 1,
@@ -354,74 +487,87 @@ impl Collapses {
         );
         ensure!(
             "Collapses",
-            self.appended.is_empty() || self.appended.len() == self.steps.len(),
-            "self.appended.is_empty() || self.appended.len() == self.steps.len()"
-        );
-        ensure!(
-            "Collapses",
             self.companion_start.is_empty()
                 || (self.companion_start.len() == self.steps.len() + 1
+                    && self.companion_start[0] == 0
                     && self.companion_start.windows(2).all(|w| w[0] <= w[1])
                     && *self.companion_start.last().unwrap() as usize == self.companions.len()),
             "companion table"
         );
+        if optimal {
+            // One created vertex per pair moved, in step order.
+            let expected = (0..=self.steps.len())
+                .map(|i| i as u32 + self.companion_start.get(i).copied().unwrap_or(0));
+            ensure!(
+                "Collapses",
+                self.created_start.len() == self.steps.len() + 1
+                    && self.created_start.iter().copied().eq(expected)
+                    && self.appended.len() == self.steps.len() + self.companions.len(),
+                "{} created vertices for {} steps and {} companions",
+                self.appended.len(),
+                self.steps.len(),
+                self.companions.len()
+            );
+        } else {
+            ensure!(
+                "Collapses",
+                self.created_start.is_empty(),
+                "created-vertex table without optimal placement"
+            );
+        }
+        let p = &self.created_properties;
+        ensure!(
+            "Collapses",
+            p.position_ids.is_empty() && p.texture.is_none(),
+            "created vertices' properties hold position ids or a texture"
+        );
+        if !p.is_empty() {
+            if let Err(why) = p.validate(&self.appended) {
+                ensure!("Collapses", false, "created vertices' properties: {why}");
+            }
+        }
         let mut removed_at = vec![u32::MAX; total];
         let mut last_error = 0.0f32;
         for (i, s) in self.steps.iter().enumerate() {
-            let (r, k) = (s.removed as usize, s.kept as usize);
-            ensure!(
-                "Collapses",
-                r < total && k < total && r != k,
-                "step {i}: bad vertices {s:?}"
-            );
-            ensure!(
-                "Collapses",
-                removed_at[r] == u32::MAX,
-                "step {i}: vertex {r} removed twice"
-            );
-            ensure!(
-                "Collapses",
-                removed_at[k] == u32::MAX,
-                "step {i}: kept vertex {k} already removed"
-            );
-            removed_at[r] = i as u32;
-            let target = self.target(i);
-            ensure!(
-                "Collapses",
-                !self.is_optimal_placement() || (r.max(k) < target as usize),
-                "step {i}: uses a vertex created later"
-            );
-            if self.is_optimal_placement() {
-                removed_at[k] = i as u32;
+            let created = self.created(i);
+            for (j, (r, k)) in self.pairs(i).enumerate() {
+                let (r, k) = (r as usize, k as usize);
+                let what = if j == 0 { "step" } else { "companion" };
                 ensure!(
                     "Collapses",
-                    self.parent[k] == target,
-                    "step {i}: forest link of the kept endpoint"
+                    r < total && k < total && r != k,
+                    "step {i}: bad {what} {r} -> {k}"
                 );
-            }
-            if let Some(w) = self.companion_start.get(i..i + 2) {
                 ensure!(
                     "Collapses",
-                    !self.is_optimal_placement(),
-                    "step {i}: companions in optimal placement"
+                    removed_at[r] == u32::MAX && removed_at[k] == u32::MAX,
+                    "step {i}: {what} {r} -> {k} uses a removed vertex"
                 );
-                for &(cr, ck) in &self.companions[w[0] as usize..w[1] as usize] {
-                    let (cr, ck) = (cr as usize, ck as usize);
+                removed_at[r] = i as u32;
+                if optimal {
+                    let c = created.start + j as u32;
                     ensure!(
                         "Collapses",
-                        cr < total && ck < total && cr != ck,
-                        "step {i}: bad companion {cr} -> {ck}"
+                        r.max(k) < created.start as usize,
+                        "step {i}: uses a vertex created later"
                     );
                     ensure!(
                         "Collapses",
-                        removed_at[cr] == u32::MAX && removed_at[ck] == u32::MAX,
-                        "step {i}: companion {cr} -> {ck} uses a removed vertex"
+                        self.appended[c as usize - self.vertex_count]
+                            == self.appended[created.start as usize - self.vertex_count],
+                        "step {i}: created vertices at different positions"
                     );
-                    removed_at[cr] = i as u32;
+                    removed_at[k] = i as u32;
                     ensure!(
                         "Collapses",
-                        self.parent[cr] == ck as u32,
-                        "step {i}: forest link of a companion"
+                        self.parent[r] == c && self.parent[k] == c,
+                        "step {i}: forest links of {what} {r} -> {k}"
+                    );
+                } else {
+                    ensure!(
+                        "Collapses",
+                        self.parent[r] == k as u32,
+                        "step {i}: forest link of {what} {r} -> {k}"
                     );
                 }
             }
@@ -431,11 +577,6 @@ impl Collapses {
                 "step {i}: error decreases"
             );
             last_error = s.error;
-            ensure!(
-                "Collapses",
-                self.parent[r] == target,
-                "step {i}: forest link"
-            );
         }
         Ok(())
     }

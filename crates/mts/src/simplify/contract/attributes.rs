@@ -30,6 +30,41 @@ const MOST_VERTICES: usize = 16;
 /// Channels at most: 2 texture coordinates, 3 normal, 4 colour.
 const MAX_CHANNELS: usize = 9;
 
+/// A property stream a channel reads a component of.
+#[derive(Debug, Clone, Copy)]
+enum Stream {
+    Uv,
+    Normal,
+    Color,
+}
+
+/// The channels of `p` with a positive weight: `(stream, component,
+/// scale)`, texture coordinates first, then normals, then colours.
+fn layout(p: &Properties, weights: AttributeWeights, diagonal: f64) -> Vec<(Stream, usize, f64)> {
+    let mut out = Vec::new();
+    for (present, w, stream, n) in [
+        (p.uvs.is_some(), weights.uv, Stream::Uv, 2),
+        (p.normals.is_some(), weights.normal, Stream::Normal, 3),
+        (p.colors.is_some(), weights.color, Stream::Color, 4),
+    ] {
+        if present && w > 0.0 {
+            let scale = f64::from(w) * diagonal;
+            out.extend((0..n).map(|c| (stream, c, scale)));
+        }
+    }
+    out
+}
+
+/// The scaled value of `channel` at vertex `v` of `p`.
+fn value(p: &Properties, v: usize, (stream, c, scale): (Stream, usize, f64)) -> f64 {
+    let x = match stream {
+        Stream::Uv => p.uvs.as_ref().map(|s| s[v].to_array()[c]),
+        Stream::Normal => p.normals.as_ref().map(|s| s[v].to_array()[c]),
+        Stream::Color => p.colors.as_ref().map(|s| s[v].to_array()[c]),
+    };
+    scale * f64::from(x.expect("the layout names present streams"))
+}
+
 /// One channel's quadric: `Σ w (g·p + d - s)²` expanded.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Channel {
@@ -90,6 +125,8 @@ impl Channel {
 pub(super) struct Attributes {
     /// Channels per vertex.
     k: usize,
+    /// What each channel reads, and its scale.
+    layout: Vec<(Stream, usize, f64)>,
     /// `k` scaled values per vertex.
     values: Vec<f64>,
     /// Per vertex, the part of its channels' quadrics that does not depend
@@ -119,44 +156,16 @@ impl Attributes {
         weights: AttributeWeights,
         diagonal: f64,
     ) -> Option<Attributes> {
-        let p: &Properties = &mesh.properties;
         let n = mesh.vertex_count();
-        let mut streams: Vec<Box<dyn Fn(usize) -> f64 + '_>> = Vec::new();
-        if let (Some(uvs), w) = (&p.uvs, weights.uv) {
-            if w > 0.0 {
-                let s = f64::from(w) * diagonal;
-                streams.push(Box::new(move |v| s * f64::from(uvs[v].x)));
-                streams.push(Box::new(move |v| s * f64::from(uvs[v].y)));
-            }
-        }
-        if let (Some(normals), w) = (&p.normals, weights.normal) {
-            if w > 0.0 {
-                let s = f64::from(w) * diagonal;
-                for c in 0..3 {
-                    streams.push(Box::new(move |v: usize| {
-                        s * f64::from(normals[v].to_array()[c])
-                    }));
-                }
-            }
-        }
-        if let (Some(colors), w) = (&p.colors, weights.color) {
-            if w > 0.0 {
-                let s = f64::from(w) * diagonal;
-                for c in 0..4 {
-                    streams.push(Box::new(move |v: usize| {
-                        s * f64::from(colors[v].to_array()[c])
-                    }));
-                }
-            }
-        }
-        let k = streams.len();
+        let layout = layout(&mesh.properties, weights, diagonal);
+        let k = layout.len();
         if k == 0 {
             return None;
         }
         let mut values = vec![0.0; n * k];
         for v in 0..n {
-            for (c, f) in streams.iter().enumerate() {
-                values[v * k + c] = f(v);
+            for (c, &channel) in layout.iter().enumerate() {
+                values[v * k + c] = value(&mesh.properties, v, channel);
             }
         }
         let mut channels = vec![Channel::default(); n * k];
@@ -221,6 +230,7 @@ impl Attributes {
             .collect();
         Some(Attributes {
             k,
+            layout,
             values,
             shared,
             linear,
@@ -282,6 +292,85 @@ impl Attributes {
         } else {
             0.0
         }
+    }
+
+    /// [`Attributes::cost`] for optimal placement, where `a` and `b` both
+    /// move to `p` and each pair's created vertex takes the values `t` of
+    /// the way from its `a` side to its `b` side (`created.rs`): the mean,
+    /// over the triangles of both vertices of each pair, of their error
+    /// there, each vertex of `a` paired with the vertex of `b` that costs
+    /// least (the seam guard later fixes the pairing). Bounded as
+    /// [`Attributes::cost`] is.
+    pub(super) fn cost_between(&self, a: u32, b: u32, p: DVec3, t: f64) -> f64 {
+        let (mut sum, mut weight) = (0.0, 0.0);
+        let live = |point: u32| self.vertices_of(point).iter().copied().take(MOST_VERTICES);
+        let k = self.k;
+        let at = |v: u32, out: &mut [f64; MAX_CHANNELS]| {
+            for (o, &(g, d)) in out
+                .iter_mut()
+                .zip(&self.linear[v as usize * k..(v as usize + 1) * k])
+            {
+                *o = g.dot(p) + d;
+            }
+            self.shared[v as usize].evaluate(p, 0.0, 0.0)
+        };
+        let (mut at_a, mut at_b) = ([0.0f64; MAX_CHANNELS], [0.0f64; MAX_CHANNELS]);
+        for wa in live(a) {
+            let own_a = at(wa, &mut at_a);
+            let sa = &self.values[wa as usize * k..(wa as usize + 1) * k];
+            let best = live(b)
+                .map(|wb| {
+                    let own_b = at(wb, &mut at_b);
+                    let sb = &self.values[wb as usize * k..(wb as usize + 1) * k];
+                    let (mut cross, mut squares) = (0.0, 0.0);
+                    for c in 0..k {
+                        let s = sa[c] + t * (sb[c] - sa[c]);
+                        cross += s * (at_a[c] + at_b[c]);
+                        squares += s * s;
+                    }
+                    let w = self.weight[wa as usize] + self.weight[wb as usize];
+                    ((own_a + own_b - 2.0 * cross + w * squares).max(0.0), w)
+                })
+                .fold((f64::INFINITY, 0.0), |x, y| if y.0 < x.0 { y } else { x });
+            if best.0.is_finite() {
+                sum += best.0;
+                weight += best.1;
+            }
+        }
+        if weight > 0.0 {
+            sum / weight
+        } else {
+            0.0
+        }
+    }
+
+    /// A point created by optimal placement, after the last one, whose
+    /// vertices are `vertices` (created by [`Attributes::create`]).
+    pub(super) fn push_point(&mut self, vertices: impl IntoIterator<Item = u32>) {
+        self.point_vertices.extend(vertices);
+        self.point_start.push(self.point_vertices.len() as u32);
+    }
+
+    /// Vertex `c` (the next one) created for the pair `wa`, `wb`, with its
+    /// values read from `properties`: both quadrics join in its own.
+    pub(super) fn create(&mut self, c: u32, wa: u32, wb: u32, properties: &Properties) {
+        let k = self.k;
+        assert_eq!(self.values.len(), c as usize * k, "created out of order");
+        for &channel in &self.layout {
+            self.values.push(value(properties, c as usize, channel));
+        }
+        let values = &self.values[c as usize * k..];
+        self.squares.push(values.iter().map(|x| x * x).sum());
+        let mut shared = self.shared[wa as usize];
+        shared.add(&self.shared[wb as usize]);
+        self.shared.push(shared);
+        for ch in 0..k {
+            let (ga, da) = self.linear[wa as usize * k + ch];
+            let (gb, db) = self.linear[wb as usize * k + ch];
+            self.linear.push((ga + gb, da + db));
+        }
+        self.weight
+            .push(self.weight[wa as usize] + self.weight[wb as usize]);
     }
 
     /// Vertex `wa` moved onto `wb`: its quadric joins `wb`'s.

@@ -69,6 +69,7 @@
 mod attributes;
 mod choice;
 mod cost;
+mod created;
 mod distances;
 mod guards;
 mod placement;
@@ -127,8 +128,9 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     }
     let with_properties = !mesh.properties.is_empty();
     match options.placement {
-        Placement::Endpoint if with_properties => contract_points(mesh, options),
+        Placement::Endpoint if with_properties => contract_points::<Endpoint>(mesh, options),
         Placement::Endpoint => contract::<Endpoint>(mesh, options),
+        Placement::Optimal if with_properties => contract_points::<Optimal>(mesh, options),
         Placement::Optimal => contract::<Optimal>(mesh, options),
     }
 }
@@ -142,10 +144,10 @@ fn contract<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplification 
 
 /// The whole sequence of a mesh with properties, contracted point by point
 /// (`seams.rs`; every vertex its own point when none is split), with the
-/// attribute quadrics in the cost (`attributes.rs`). Optimal placement does not take this path yet: it would
-/// need properties for the vertices it creates, and runs on the vertices
-/// as they are (a seam is then a border, and may open).
-fn contract_points(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
+/// attribute quadrics in the cost (`attributes.rs`). With optimal placement
+/// each step creates one vertex per seam pair, with interpolated
+/// properties (`created.rs`).
+fn contract_points<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     let identity: Vec<u32>;
     let ids = if mesh.properties.position_ids.is_empty() {
         identity = (0..mesh.vertex_count() as u32).collect();
@@ -167,9 +169,16 @@ fn contract_points(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
             .collect(),
         properties: Default::default(),
     };
-    let mut c = Contractor::<Endpoint>::new_with(&point_mesh, options, |c| {
+    let mut c = Contractor::<P>::new_with(&point_mesh, options, |c| {
         c.corners.clone_from(&mesh.triangles);
         c.output_vertices = mesh.vertex_count();
+        if P::MOVES_KEPT {
+            c.properties = Some(crate::mesh::Properties {
+                position_ids: Vec::new(),
+                texture: None,
+                ..mesh.properties.clone()
+            });
+        }
         c.attributes =
             attributes::Attributes::new(mesh, ids, points, options.attribute_weights, c.diagonal);
     });
@@ -252,6 +261,15 @@ struct Contractor<P> {
     companions: Vec<Vec<(u32, u32)>>,
     /// Attribute quadrics of the vertices (a mesh with properties only).
     attributes: Option<attributes::Attributes>,
+    /// Optimal placement on a mesh with properties: the property streams
+    /// of every vertex, the input's then the created ones (`created.rs`).
+    properties: Option<crate::mesh::Properties>,
+    /// Scratch `(old vertex, created vertex)` moves of a step in optimal
+    /// placement on a mesh with properties.
+    corner_moves: Vec<(u32, u32)>,
+    /// Output vertices created so far (optimal placement on a mesh with
+    /// properties; one per step otherwise, not counted here).
+    created_count: usize,
     /// Vertices of the output sequence: the input's, or on a mesh with
     /// seams its vertices (not its points).
     output_vertices: usize,
@@ -419,6 +437,9 @@ impl<P: Place> Contractor<P> {
             seam_pairs: Vec::new(),
             companions: Vec::new(),
             attributes: None,
+            properties: None,
+            corner_moves: Vec::new(),
+            created_count: 0,
             output_vertices: n,
             diagonal,
             pos,
@@ -585,12 +606,28 @@ impl<P: Place> Contractor<P> {
         }
         let error = P::recorded_error(self, a, target, cost, forward);
         let q = self.quadrics[a as usize] + self.quadrics[b as usize];
+        let t = created::along(self.p(a), self.p(b), target);
         let survivor = P::merge(self, a, b, target);
         self.quadrics[survivor as usize] = q;
+        // Optimal placement on a mesh with properties: each seam pair's
+        // vertices move onto a vertex created for the pair.
+        let create = survivor != b && !self.corners.is_empty();
+        let first_created = if create {
+            let first = self.output_vertices + self.created_count;
+            self.corner_moves.clear();
+            for (j, &(va, vb)) in self.seam_pairs.iter().enumerate() {
+                let c = (first + j) as u32;
+                self.corner_moves.extend([(va, c), (vb, c)]);
+            }
+            first
+        } else {
+            0
+        };
         // The survivor's list: b's live triangles without `a`, then `a`'s
         // live ones (which never contain `b`), in b's block when it has room.
         let mut dead = 0u32;
         let tris = &mut self.tris;
+        let (corners, moves) = (&mut self.corners, &self.corner_moves);
         self.fans.retain(b, |t| {
             let tri = &mut tris[t as usize];
             if tri[0] == DEAD {
@@ -601,9 +638,13 @@ impl<P: Place> Contractor<P> {
                 dead += 1;
                 return false;
             }
-            for w in tri.iter_mut() {
+            for (slot, w) in tri.iter_mut().enumerate() {
                 if *w == b {
                     *w = survivor;
+                    if create {
+                        let c = &mut corners[t as usize][slot];
+                        *c = Self::seam_target(moves, *c);
+                    }
                 }
             }
             true
@@ -612,7 +653,11 @@ impl<P: Place> Contractor<P> {
             self.fans.move_into(b, survivor, |_| true);
             self.removed[b as usize] = true;
         }
-        let (corners, pairs) = (&mut self.corners, &self.seam_pairs);
+        let (corners, pairs) = if create {
+            (&mut self.corners, &self.corner_moves)
+        } else {
+            (&mut self.corners, &self.seam_pairs)
+        };
         self.fans.move_into(a, survivor, |t| {
             let tri = &mut tris[t as usize];
             if tri[0] == DEAD {
@@ -657,7 +702,25 @@ impl<P: Place> Contractor<P> {
         self.triangles_now -= dead;
         let rms = error.max(0.0).sqrt() / self.diagonal;
         self.max_error = self.max_error.max(rms as f32);
-        if let Some(attributes) = &mut self.attributes {
+        if create {
+            let pairs = self.seam_pairs.len();
+            if let Some(props) = &mut self.properties {
+                for &(va, vb) in &self.seam_pairs {
+                    created::push_interpolated(props, va, vb, t);
+                }
+            }
+            if let Some(attributes) = &mut self.attributes {
+                let props = self
+                    .properties
+                    .as_ref()
+                    .expect("optimal placement keeps properties");
+                for (j, &(va, vb)) in self.seam_pairs.iter().enumerate() {
+                    attributes.create((first_created + j) as u32, va, vb, props);
+                }
+                attributes.push_point((0..pairs).map(|j| (first_created + j) as u32));
+            }
+            self.created_count += pairs;
+        } else if let Some(attributes) = &mut self.attributes {
             for &(wa, wb) in &self.seam_pairs {
                 attributes.merge(wa, wb);
             }
@@ -767,12 +830,29 @@ impl<P: Place> Contractor<P> {
 
     fn finish(self) -> Simplification {
         let stop = self.stop.expect("run() records where it stopped");
-        let collapses = Collapses::with_companions(
+        let mut created = self.place.into_created();
+        let mut created_properties = crate::mesh::Properties::default();
+        if !self.corners.is_empty() && !created.is_empty() {
+            // One created vertex per pair of each step, at the step's point.
+            created = created
+                .iter()
+                .zip(&self.companions)
+                .flat_map(|(&p, c)| std::iter::repeat_n(p, 1 + c.len()))
+                .collect();
+        }
+        if let Some(mut p) = self.properties {
+            let n = self.output_vertices;
+            created_properties.normals = p.normals.as_mut().map(|s| s.split_off(n));
+            created_properties.uvs = p.uvs.as_mut().map(|s| s.split_off(n));
+            created_properties.colors = p.colors.as_mut().map(|s| s.split_off(n));
+        }
+        let collapses = Collapses::with_created_properties(
             self.output_vertices,
             self.steps,
             self.triangle_counts,
-            self.place.into_created(),
+            created,
             self.companions,
+            created_properties,
         );
         Simplification { collapses, stop }
     }

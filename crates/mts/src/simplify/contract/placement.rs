@@ -193,7 +193,11 @@ impl Place for Optimal {
 
     fn pair_cost(c: &Contractor<Self>, v: u32, w: u32) -> f64 {
         let q = c.quadrics[v as usize] + c.quadrics[w as usize];
-        c.optimal_point(&q, v, w).1
+        let (p, cost) = c.optimal_point(&q, v, w);
+        match &c.attributes {
+            Some(a) => cost + a.cost_between(v, w, p, created::along(c.p(v), c.p(w), p)),
+            None => cost,
+        }
     }
 
     fn target(c: &Contractor<Self>, a: u32, b: u32) -> DVec3 {
@@ -206,8 +210,15 @@ impl Place for Optimal {
         (0.0, 0.0)
     }
 
-    fn recorded_error(_: &Contractor<Self>, _: u32, _: DVec3, cost: f32, _: f64) -> f64 {
-        f64::from(cost)
+    /// The queue's cost, less the attribute cost where there is one (the
+    /// recorded error is geometric).
+    fn recorded_error(c: &Contractor<Self>, a: u32, target: DVec3, cost: f32, _: f64) -> f64 {
+        match (&c.attributes, c.queued[a as usize].1) {
+            (Some(_), b) if b != NONE => {
+                (c.quadrics[a as usize] + c.quadrics[b as usize]).mean_error(target)
+            }
+            _ => f64::from(cost),
+        }
     }
 
     fn merge(c: &mut Contractor<Self>, _: u32, _: u32, target: DVec3) -> u32 {

@@ -18,12 +18,17 @@
 //! - two vertices of `a` are paired with one of `b` (the two sides of the
 //!   seam would share `b`'s properties: a smear).
 //!
-//! - the point pairs more than [`MOST_PAIRS`] vertices (a hostile split).
+//! - the point pairs more than [`MOST_PAIRS`] vertices (a hostile split),
+//!   or
+//! - with optimal placement, which moves `b` too, a vertex of `b` that live
+//!   triangles use is paired with no vertex of `a` (it would leave the seam
+//!   where `b` was: a tear). The pairing is then one to one, and each pair
+//!   becomes one created vertex (`created.rs`).
 //!
 //! So a seam is simplified along itself, as a border is, and its points
 //! never multiply. Virtual pairs (no shared triangle) are refused on a
-//! seamed mesh. Each vertex keeps its input properties (endpoint
-//! placement), so a LoD change rewrites indices only.
+//! seamed mesh. With endpoint placement each vertex keeps its input
+//! properties, so a LoD change rewrites indices only.
 
 use super::*;
 
@@ -73,6 +78,22 @@ impl<P: Place> Contractor<P> {
                 let sa = tri.iter().position(|&w| w == a).expect("a's fan holds a");
                 let wa = self.corners[t as usize][sa];
                 if !map.iter().any(|&(x, _)| x == wa) {
+                    fine = false;
+                    break;
+                }
+            }
+        }
+        if fine && P::MOVES_KEPT {
+            // Optimal placement moves `b` too: each of its vertices in use
+            // needs a partner of `a` to share the vertex created for them.
+            for &t in self.fans.get(b) {
+                let tri = self.tris[t as usize];
+                if tri[0] == DEAD || tri.contains(&a) {
+                    continue;
+                }
+                let sb = tri.iter().position(|&w| w == b).expect("b's fan holds b");
+                let wb = self.corners[t as usize][sb];
+                if !map.iter().any(|&(_, y)| y == wb) {
                     fine = false;
                     break;
                 }
