@@ -15,6 +15,7 @@ pub mod cluster;
 #[cfg(feature = "peers")]
 pub mod discrete;
 mod levels;
+mod props;
 pub mod multilevel;
 pub mod pm;
 
