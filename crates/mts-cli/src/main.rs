@@ -345,8 +345,9 @@ struct MeshSource {
     weld: bool,
     /// Read normals, texture coordinates, colours and the texture (OBJ
     /// vertices are split where a position has several); every LoD keeps
-    /// every seam, and `simplify -o`, `build` and `extract -o` keep them.
-    /// The baselines (`encode`, `compare`) do not carry them yet.
+    /// every seam, and `simplify -o`, `build`, `extract -o`, the baselines
+    /// (`encode`, `compare`) and `decode -o` keep them. `demo` refuses
+    /// them (its scenes do not carry them yet).
     #[arg(long)]
     properties: bool,
 }
@@ -375,11 +376,11 @@ impl MeshSource {
         Ok((name, model))
     }
 
-    /// [`MeshSource::load`] for the commands that build the baselines,
-    /// cluster trees or scenes, which do not carry properties yet.
-    fn load_for_model(&self) -> Result<(String, Mesh, CleanReport)> {
+    /// [`MeshSource::load`] for the commands that lay out scenes, which do
+    /// not carry properties yet.
+    fn load_for_scene(&self) -> Result<(String, Mesh, CleanReport)> {
         if self.properties {
-            bail!("the baselines and scenes do not carry vertex properties yet: drop --properties");
+            bail!("scenes do not carry vertex properties yet: drop --properties");
         }
         self.load()
     }
@@ -844,7 +845,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Extract(args) => extract(args),
         Command::Bench(args) => bench_cmd(args),
         Command::Demo(args) => {
-            let (name, mesh, _) = args.source.load_for_model()?;
+            let (name, mesh, _) = args.source.load_for_scene()?;
             demo::run(&name, &mesh, &args.thumbnails)
         }
         Command::Encode(args) => encode(args),
@@ -1422,15 +1423,22 @@ struct EncodeArgs {
     json: bool,
 }
 
+/// The raw mesh with 16-bit indices (12 bytes per vertex, 6 per
+/// triangle) plus its property values, so that a method carrying
+/// properties is compared with a raw mesh carrying them too.
+fn raw_bytes_u16(mesh: &Mesh) -> usize {
+    mesh.raw_bytes_u16() + mesh.properties.bytes_per_vertex() * mesh.vertex_count()
+}
+
 fn encode(args: &EncodeArgs) -> Result<()> {
-    let (name, mesh, _) = args.source.load_for_model()?;
+    let (name, mesh, _) = args.source.load()?;
     let t = Instant::now();
     let tree = mts::baselines::ClusterTree::new(&mesh)?;
     let bytes = tree.to_stream();
     let ms = t.elapsed().as_secs_f64() * 1e3;
     std::fs::write(&args.output, &bytes)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
-    let raw = mesh.raw_bytes_u16();
+    let raw = raw_bytes_u16(&mesh);
     if args.json {
         println!(
             "{}",
@@ -1547,7 +1555,7 @@ fn measure_methods(
     requests: usize,
 ) -> Result<Vec<MethodRow>> {
     use mts::model::sequence;
-    let raw = mesh.raw_bytes_u16();
+    let raw = raw_bytes_u16(&mesh);
     let mut rows = Vec::new();
     for method in Method::ALL {
         if method == Method::Discrete {
@@ -1594,11 +1602,11 @@ fn measure_methods(
 }
 
 fn compare(args: &CompareArgs) -> Result<()> {
-    let (name, mesh, _) = args.source.load_for_model()?;
+    let (name, mesh, _) = args.source.load()?;
     let t = Instant::now();
     let (model, _, _) = build_with_bar(&mesh, &Default::default());
     let mts_ms = t.elapsed().as_secs_f64() * 1e3;
-    let raw = mesh.raw_bytes_u16();
+    let raw = raw_bytes_u16(&mesh);
     let rows = measure_methods(&model, &mesh, mts_ms, args.requests)?;
     let mesh_info = json!({
         "input": name,
