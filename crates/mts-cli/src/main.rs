@@ -1555,7 +1555,7 @@ fn measure_methods(
     requests: usize,
 ) -> Result<Vec<MethodRow>> {
     use mts::model::sequence;
-    let raw = raw_bytes_u16(&mesh);
+    let raw = raw_bytes_u16(mesh);
     let mut rows = Vec::new();
     for method in Method::ALL {
         if method == Method::Discrete {

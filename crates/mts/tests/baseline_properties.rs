@@ -158,7 +158,10 @@ fn discrete_lods_draw_the_input_properties() {
         36 * mesh.vertex_count()
     );
     d.set_lod(c.max_lod() / 2);
-    assert!(d.indices().iter().all(|&v| (v as usize) < mesh.vertex_count()));
+    assert!(d
+        .indices()
+        .iter()
+        .all(|&v| (v as usize) < mesh.vertex_count()));
 }
 
 #[test]
@@ -238,7 +241,11 @@ fn damaged_second_format_files_get_located_errors() {
     let c = collapses(&mesh);
     let pm = ProgressiveMesh::new(&mesh, &c).unwrap();
     let bytes = pm.to_bytes();
-    let err = |b: &[u8]| ProgressiveMesh::from_bytes(b, "bad.pm").unwrap_err().to_string();
+    let err = |b: &[u8]| {
+        ProgressiveMesh::from_bytes(b, "bad.pm")
+            .unwrap_err()
+            .to_string()
+    };
     // Header: magic, counts (3 × 4 bytes), roots (4), flags (1).
     let mut flags = bytes.clone();
     flags[24] = 0xf8;
@@ -311,7 +318,12 @@ fn spot_baselines_match_the_oracle_with_properties() {
         &mut ProgressiveMesh::new(&mesh, &c).unwrap(),
         &spread,
     );
-    check(&mesh, &c, &mut MultilevelMesh::new(&mesh, &c).unwrap(), &spread);
+    check(
+        &mesh,
+        &c,
+        &mut MultilevelMesh::new(&mesh, &c).unwrap(),
+        &spread,
+    );
     let pm = ProgressiveMesh::new(&mesh, &c).unwrap();
     let back = ProgressiveMesh::from_bytes(&pm.to_bytes(), "spot.pm").unwrap();
     assert_eq!(back.to_bytes(), pm.to_bytes());

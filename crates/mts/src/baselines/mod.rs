@@ -15,9 +15,9 @@ pub mod cluster;
 #[cfg(feature = "peers")]
 pub mod discrete;
 mod levels;
-mod props;
 pub mod multilevel;
 pub mod pm;
+mod props;
 
 pub use cluster::ClusterTree;
 #[cfg(feature = "peers")]

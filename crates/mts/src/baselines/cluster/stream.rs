@@ -337,13 +337,15 @@ fn decode_with(bytes: &[u8], file: &str, strict: bool) -> Result<Decoded> {
         if !d.is_complete() {
             return Err(shift(
                 r.error(
-                "end",
-                format!(
-                    "{} vertices and {} triangles decoded, the header says {n} and {t}",
-                    d.positions.len(),
-                    d.triangles.len()
+                    "end",
+                    format!(
+                        "{} vertices and {} triangles decoded, the header says {n} and {t}",
+                        d.positions.len(),
+                        d.triangles.len()
+                    ),
                 ),
-            ), header));
+                header,
+            ));
         }
         r.finish("end").map_err(|e| shift(e, header))?;
     }
