@@ -1430,6 +1430,15 @@ fn raw_bytes_u16(mesh: &Mesh) -> usize {
     mesh.raw_bytes_u16() + mesh.properties.bytes_per_vertex() * mesh.vertex_count()
 }
 
+/// What [`raw_bytes_u16`] adds per vertex, for the sentences that say
+/// how raw is counted (nothing without properties).
+fn with_properties(mesh: &Mesh) -> String {
+    match mesh.properties.bytes_per_vertex() {
+        0 => String::new(),
+        b => format!(" and {b} of properties"),
+    }
+}
+
 fn encode(args: &EncodeArgs) -> Result<()> {
     let (name, mesh, _) = args.source.load()?;
     let t = Instant::now();
@@ -1454,11 +1463,12 @@ fn encode(args: &EncodeArgs) -> Result<()> {
         );
     } else {
         println!(
-            "{name}: {} vertices, {} triangles -> {} bytes = {:.1}% of raw ({raw} bytes: 12 per vertex + 6 per triangle), {ms:.0} ms -> {}",
+            "{name}: {} vertices, {} triangles -> {} bytes = {:.1}% of raw ({raw} bytes: 12 per vertex{} + 6 per triangle), {ms:.0} ms -> {}",
             mesh.vertex_count(),
             mesh.triangle_count(),
             bytes.len(),
             100.0 * bytes.len() as f64 / raw as f64,
+            with_properties(&mesh),
             args.output.display()
         );
     }
@@ -1620,9 +1630,10 @@ fn compare(args: &CompareArgs) -> Result<()> {
         return Ok(());
     }
     println!(
-        "{name}: {} vertices, {} triangles, raw {raw} bytes (12 per vertex + 6 per triangle); {} requests per sequence",
+        "{name}: {} vertices, {} triangles, raw {raw} bytes (12 per vertex{} + 6 per triangle); {} requests per sequence",
         mesh.vertex_count(),
         mesh.triangle_count(),
+        with_properties(&mesh),
         args.requests
     );
     println!(
