@@ -345,8 +345,9 @@ struct MeshSource {
     weld: bool,
     /// Read normals, texture coordinates, colours and the texture (OBJ
     /// vertices are split where a position has several); every LoD keeps
-    /// every seam, and `simplify -o`, `build` and `extract -o` keep them.
-    /// The baselines (`encode`, `compare`) do not carry them yet.
+    /// every seam, and `simplify -o`, `build`, `extract -o`, the baselines
+    /// (`encode`, `compare`) and `decode -o` keep them. `demo` refuses
+    /// them (its scenes do not carry them yet).
     #[arg(long)]
     properties: bool,
 }
@@ -375,11 +376,11 @@ impl MeshSource {
         Ok((name, model))
     }
 
-    /// [`MeshSource::load`] for the commands that build the baselines,
-    /// cluster trees or scenes, which do not carry properties yet.
-    fn load_for_model(&self) -> Result<(String, Mesh, CleanReport)> {
+    /// [`MeshSource::load`] for the commands that lay out scenes, which do
+    /// not carry properties yet.
+    fn load_for_scene(&self) -> Result<(String, Mesh, CleanReport)> {
         if self.properties {
-            bail!("the baselines and scenes do not carry vertex properties yet: drop --properties");
+            bail!("scenes do not carry vertex properties yet: drop --properties");
         }
         self.load()
     }
@@ -858,7 +859,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Extract(args) => extract(args),
         Command::Bench(args) => bench_cmd(args),
         Command::Demo(args) => {
-            let (name, mesh, _) = args.source.load_for_model()?;
+            let (name, mesh, _) = args.source.load_for_scene()?;
             demo::run(&name, &mesh, &args.thumbnails)
         }
         Command::Encode(args) => encode(args),
@@ -1447,15 +1448,31 @@ struct EncodeArgs {
     json: bool,
 }
 
+/// The raw mesh with 16-bit indices (12 bytes per vertex, 6 per
+/// triangle) plus its property values, so that a method carrying
+/// properties is compared with a raw mesh carrying them too.
+fn raw_bytes_u16(mesh: &Mesh) -> usize {
+    mesh.raw_bytes_u16() + mesh.properties.bytes_per_vertex() * mesh.vertex_count()
+}
+
+/// What [`raw_bytes_u16`] adds per vertex, for the sentences that say
+/// how raw is counted (nothing without properties).
+fn with_properties(mesh: &Mesh) -> String {
+    match mesh.properties.bytes_per_vertex() {
+        0 => String::new(),
+        b => format!(" and {b} of properties"),
+    }
+}
+
 fn encode(args: &EncodeArgs) -> Result<()> {
-    let (name, mesh, _) = args.source.load_for_model()?;
+    let (name, mesh, _) = args.source.load()?;
     let t = Instant::now();
     let tree = mts::baselines::ClusterTree::new(&mesh)?;
     let bytes = tree.to_stream();
     let ms = t.elapsed().as_secs_f64() * 1e3;
     std::fs::write(&args.output, &bytes)
         .with_context(|| format!("cannot write {}", args.output.display()))?;
-    let raw = mesh.raw_bytes_u16();
+    let raw = raw_bytes_u16(&mesh);
     if args.json {
         println!(
             "{}",
@@ -1471,11 +1488,12 @@ fn encode(args: &EncodeArgs) -> Result<()> {
         );
     } else {
         println!(
-            "{name}: {} vertices, {} triangles -> {} bytes = {:.1}% of raw ({raw} bytes: 12 per vertex + 6 per triangle), {ms:.0} ms -> {}",
+            "{name}: {} vertices, {} triangles -> {} bytes = {:.1}% of raw ({raw} bytes: 12 per vertex{} + 6 per triangle), {ms:.0} ms -> {}",
             mesh.vertex_count(),
             mesh.triangle_count(),
             bytes.len(),
             100.0 * bytes.len() as f64 / raw as f64,
+            with_properties(&mesh),
             args.output.display()
         );
     }
@@ -1572,7 +1590,7 @@ fn measure_methods(
     requests: usize,
 ) -> Result<Vec<MethodRow>> {
     use mts::model::sequence;
-    let raw = mesh.raw_bytes_u16();
+    let raw = raw_bytes_u16(mesh);
     let mut rows = Vec::new();
     for method in Method::ALL {
         if method == Method::Discrete {
@@ -1619,11 +1637,11 @@ fn measure_methods(
 }
 
 fn compare(args: &CompareArgs) -> Result<()> {
-    let (name, mesh, _) = args.source.load_for_model()?;
+    let (name, mesh, _) = args.source.load()?;
     let t = Instant::now();
     let (model, _, _) = build_with_bar(&mesh, &Default::default());
     let mts_ms = t.elapsed().as_secs_f64() * 1e3;
-    let raw = mesh.raw_bytes_u16();
+    let raw = raw_bytes_u16(&mesh);
     let rows = measure_methods(&model, &mesh, mts_ms, args.requests)?;
     let mesh_info = json!({
         "input": name,
@@ -1637,9 +1655,10 @@ fn compare(args: &CompareArgs) -> Result<()> {
         return Ok(());
     }
     println!(
-        "{name}: {} vertices, {} triangles, raw {raw} bytes (12 per vertex + 6 per triangle); {} requests per sequence",
+        "{name}: {} vertices, {} triangles, raw {raw} bytes (12 per vertex{} + 6 per triangle); {} requests per sequence",
         mesh.vertex_count(),
         mesh.triangle_count(),
+        with_properties(&mesh),
         args.requests
     );
     println!(

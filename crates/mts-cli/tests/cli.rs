@@ -159,3 +159,40 @@ fn encode_decode_and_extract_with_every_method() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `encode` and `compare` take `--properties`: the stream carries the
+/// property streams (decoded back into the written mesh) and the raw
+/// reference counts them; `demo` still refuses them.
+#[test]
+fn baselines_take_properties() {
+    let dir = std::env::temp_dir().join(format!("mts-cli-props-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let stream = dir.join("torus.stream");
+    let stream = stream.to_str().unwrap();
+    let src = ["--generated", "torus:500", "--properties"];
+    let (ok, out, err) = mts(&[&["encode"][..], &src, &["-o", stream, "--json"]].concat());
+    assert!(ok, "{err}");
+    let e = json(&out);
+    let (v, t) = (
+        e["vertices"].as_u64().unwrap(),
+        e["triangles"].as_u64().unwrap(),
+    );
+    // Normals, UVs and colours: 36 bytes per vertex on top of the mesh.
+    assert_eq!(e["raw_bytes_u16"].as_u64(), Some((12 + 36) * v + 6 * t));
+    let obj = dir.join("back.obj");
+    let (ok, _, err) = mts(&["decode", stream, "-o", obj.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&obj).unwrap();
+    assert!(
+        text.lines().any(|l| l.starts_with("vt ")),
+        "no texture coordinates"
+    );
+    assert!(text.lines().any(|l| l.starts_with("vn ")), "no normals");
+    let (ok, out, err) = mts(&[&["compare"][..], &src, &["--requests", "5", "--json"]].concat());
+    assert!(ok, "{err}");
+    let methods = json(&out)["methods"].as_array().unwrap().len();
+    assert!(methods >= 4, "{out}");
+    let (ok, _, err) = mts(&[&["demo"][..], &src].concat());
+    assert!(!ok && err.contains("--properties"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -38,6 +38,11 @@ pub trait LodSource {
     /// method's own; [`LodSource::triangles`] maps back to the input's).
     fn positions(&self) -> &[Vec3];
 
+    /// The property streams (normals, UVs, colours) in the order of
+    /// [`LodSource::positions`], uploaded once: every LoD draws the same
+    /// vertices, so a LoD change rewrites indices only.
+    fn properties(&self) -> &crate::mesh::Properties;
+
     /// How [`LodSource::indices`] is drawn.
     fn topology(&self) -> Topology;
 
@@ -104,6 +109,10 @@ impl LodSource for Extractor<'_> {
 
     fn positions(&self) -> &[Vec3] {
         self.model().positions()
+    }
+
+    fn properties(&self) -> &crate::mesh::Properties {
+        self.model().properties()
     }
 
     fn topology(&self) -> Topology {

@@ -7,9 +7,13 @@
 //! A LoD `k` of the shared numbering is answered by the coarsest level
 //! that still has at least the triangle count of LoD `k` (so the image is
 //! never coarser than asked for).
+//!
+//! The levels index the input's vertex buffer, so the property streams are
+//! the input's, stored once (meshoptimizer finds seams by equal positions
+//! and simplifies along them).
 
 use crate::lod::{LodSource, Topology};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, Properties};
 use glam::Vec3;
 use std::ops::Range;
 
@@ -23,6 +27,8 @@ pub const RATIOS: [f64; 6] = crate::methods::SHARES;
 #[derive(Debug, Clone)]
 pub struct DiscreteLods {
     positions: Vec<Vec3>,
+    /// The input's normals, UVs and colours (no position ids).
+    properties: Properties,
     /// All levels' triangle lists, finest first.
     buffer: Vec<u32>,
     /// Level `l` is `buffer[level_start[l]..level_start[l + 1]]`.
@@ -66,6 +72,10 @@ impl DiscreteLods {
         }
         DiscreteLods {
             positions: mesh.positions.clone(),
+            properties: Properties {
+                position_ids: Vec::new(),
+                ..mesh.properties.clone()
+            },
             buffer,
             level_start,
             counts: counts.to_vec(),
@@ -116,6 +126,10 @@ impl LodSource for DiscreteLods {
         &self.positions
     }
 
+    fn properties(&self) -> &Properties {
+        &self.properties
+    }
+
     fn topology(&self) -> Topology {
         Topology::TriangleList
     }
@@ -152,12 +166,15 @@ impl LodSource for DiscreteLods {
     }
 
     fn memory_bytes(&self) -> usize {
-        12 * self.positions.len() + 4 * self.buffer.len() + 8 * self.level_start.len()
+        (12 + self.properties.bytes_per_vertex()) * self.positions.len()
+            + 4 * self.buffer.len()
+            + 8 * self.level_start.len()
     }
 
-    /// Positions and every level with 32-bit indices (as stored).
+    /// Positions, their property values and every level with 32-bit
+    /// indices (as stored).
     fn file_bytes(&self) -> usize {
-        12 * self.positions.len() + 4 * self.buffer.len()
+        (12 + self.properties.bytes_per_vertex()) * self.positions.len() + 4 * self.buffer.len()
     }
 
     fn triangles(&self) -> Vec<[u32; 3]> {

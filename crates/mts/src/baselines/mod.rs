@@ -17,6 +17,7 @@ pub mod discrete;
 mod levels;
 pub mod multilevel;
 pub mod pm;
+mod props;
 
 pub use cluster::ClusterTree;
 #[cfg(feature = "peers")]

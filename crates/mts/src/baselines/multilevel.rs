@@ -7,7 +7,7 @@
 //! Vertices and triangles are sorted by level (`baselines/levels.rs`: one level
 //! per contraction, so the paper's level `l` is our LoD `l`), each removed
 //! vertex stores one representative (an older vertex), and LoD `k` uses
-//! vertices `0..n_k` (`n_k = n - k`) and the triangles of level `>= k`, a
+//! vertices `0..n_k` (`n_k = n - k` without seams) and the triangles of level `>= k`, a
 //! prefix of the triangle array. A LoD change rebuilds the path-compressed
 //! representatives (*pc-rep*) of the vertices at or above `n_k` on a
 //! temporary array (O(k)), then rewrites the triangle prefix through it
@@ -21,13 +21,20 @@
 //!   break the paper's 1.1 bound; `n_k = n - k` is implicit, and the
 //!   triangle count of a LoD is found by binary search over the sorted
 //!   triangles (degenerate ones come last), following the forest as the
-//!   paper's Figure 5 does.
+//!   paper's Figure 5 does. On a mesh with seams a contraction moves a
+//!   point's several vertices (its level holds them all, as the paper's
+//!   levels hold several vertices), so `n_k` is no longer implicit and the
+//!   vertex count of each LoD is stored (4 bytes per LoD, only then).
+//! - **Properties ride with the vertices**, in level order (the paper
+//!   carries texture coordinates and colours through its levels the same
+//!   way): a vertex is drawn with its own values at every LoD, and the
+//!   byte counts include them.
 
 use super::levels::Levels;
 use crate::error::ensure;
 use crate::error::Result;
 use crate::lod::{LodSource, Topology};
-use crate::mesh::{is_degenerate, Mesh};
+use crate::mesh::{is_degenerate, Mesh, Properties};
 use crate::simplify::Collapses;
 use glam::Vec3;
 use std::ops::Range;
@@ -78,6 +85,11 @@ const DIRTY_GAP: usize = 8;
 pub struct MultilevelMesh {
     /// Positions in level order.
     positions: Vec<Vec3>,
+    /// Normals, UVs and colours in level order (no position ids).
+    properties: Properties,
+    /// Vertices at each LoD when some level holds several (a mesh with
+    /// seams); empty when each holds one (then `n_k = n - k`).
+    present: Vec<u32>,
     /// Level index -> input vertex (for [`LodSource::triangles`]; not part
     /// of the structure the paper counts).
     order: Vec<u32>,
@@ -102,7 +114,8 @@ impl MultilevelMesh {
     ///
     /// # Errors
     /// [`crate::Error::InvalidArgument`] when `collapses` uses optimal
-    /// placement or belongs to another mesh.
+    /// placement, moves two vertices of a step onto one, or belongs to
+    /// another mesh.
     pub fn new(mesh: &Mesh, collapses: &Collapses) -> Result<MultilevelMesh> {
         let levels = Levels::new(mesh, collapses)?;
         let n = levels.order.len();
@@ -116,6 +129,12 @@ impl MultilevelMesh {
                 .iter()
                 .map(|&v| mesh.positions[v as usize])
                 .collect(),
+            properties: levels.properties(mesh),
+            present: if levels.has_companions() {
+                levels.present.clone()
+            } else {
+                Vec::new()
+            },
             order: levels.order,
             roots: levels.roots,
             triangles,
@@ -135,6 +154,21 @@ impl MultilevelMesh {
         self.out.len() / 3
     }
 
+    /// The property streams in the order of [`LodSource::positions`],
+    /// uploaded once for every LoD.
+    #[must_use]
+    pub fn properties(&self) -> &Properties {
+        &self.properties
+    }
+
+    /// `n_k`: the vertices of LoD `lod` are `0..n_k`.
+    fn present(&self, lod: usize) -> usize {
+        match self.present.get(lod) {
+            Some(&p) => p as usize,
+            None => self.positions.len() - lod,
+        }
+    }
+
     /// Representative of `v` among the vertices below `n_k`, following the
     /// forest (no path compression). O(depth).
     fn root_below(&self, mut v: u32, n_k: u32) -> u32 {
@@ -149,7 +183,7 @@ impl MultilevelMesh {
     /// is older and therefore already resolved. O(lod).
     fn compress(&mut self, lod: usize) {
         let n = self.positions.len();
-        let n_k = n - lod;
+        let n_k = self.present(lod);
         for v in n_k..n {
             let r = self.representatives.get(v - self.roots);
             self.pc[v] = if (r as usize) < n_k {
@@ -193,10 +227,9 @@ impl MultilevelMesh {
                 self.max_lod()
             )));
         }
-        let n = self.positions.len();
-        let n_coarse = (n - coarse) as u32;
+        let n_coarse = self.present(coarse) as u32;
         out.clear();
-        out.extend((0..(n - fine) as u32).map(|v| {
+        out.extend((0..self.present(fine) as u32).map(|v| {
             let from = self.positions[self.root_below(v, n_coarse) as usize];
             from.lerp(self.positions[v as usize], t)
         }));
@@ -204,24 +237,29 @@ impl MultilevelMesh {
     }
 
     /// Bytes of the multilevel mesh as the paper counts them: positions
-    /// (12 per vertex), triangles and representatives at the stored index
-    /// width. Excludes the temporary pc-rep, the output buffer and the map
-    /// back to input numbering.
+    /// (12 per vertex) and their property values, triangles and
+    /// representatives at the stored index width, and the per-LoD vertex
+    /// counts when stored. Excludes the temporary pc-rep, the output
+    /// buffer and the map back to input numbering.
     #[must_use]
     pub fn structure_bytes(&self) -> usize {
-        12 * self.positions.len() + self.triangles.bytes() + self.representatives.bytes()
+        (12 + self.properties.bytes_per_vertex()) * self.positions.len()
+            + self.triangles.bytes()
+            + self.representatives.bytes()
+            + 4 * self.present.len()
     }
 
-    /// The raw mesh the paper compares with: 12 bytes per vertex and three
-    /// indices per triangle at the same width as [`Self::structure_bytes`]
-    /// uses (2 bytes up to 65,536 vertices).
+    /// The raw mesh the paper compares with: 12 bytes per vertex and its
+    /// property values, and three indices per triangle at the same width
+    /// as [`Self::structure_bytes`] uses (2 bytes up to 65,536 vertices).
     #[must_use]
     pub fn raw_bytes(&self) -> usize {
         let width = match self.triangles {
             Indices::U16(_) => 2,
             Indices::U32(_) => 4,
         };
-        12 * self.positions.len() + 3 * width * self.total_triangles()
+        (12 + self.properties.bytes_per_vertex()) * self.positions.len()
+            + 3 * width * self.total_triangles()
     }
 
     /// Checks the invariants listed on [`MultilevelMesh`].
@@ -238,8 +276,21 @@ impl MultilevelMesh {
                 "vertex {v}: representative not older"
             );
         }
+        ensure!(
+            "MultilevelMesh",
+            self.present.is_empty()
+                || (self.present[0] as usize == n
+                    && *self.present.last().unwrap() as usize == self.roots
+                    && self.present.windows(2).all(|w| w[0] > w[1])),
+            "present table"
+        );
+        ensure!(
+            "MultilevelMesh",
+            self.properties.check_counts(n).is_ok(),
+            "property streams"
+        );
         for k in [0, self.max_lod() / 2, self.max_lod()] {
-            let n_k = (n - k) as u32;
+            let n_k = self.present(k) as u32;
             let alive = self.count_at(k);
             for t in 0..self.total_triangles() {
                 let tri = [0, 1, 2].map(|c| self.root_below(self.triangles.get(3 * t + c), n_k));
@@ -256,7 +307,7 @@ impl MultilevelMesh {
     /// Triangles alive at `lod` by binary search with the forest. O(log T
     /// × depth).
     fn count_at(&self, lod: usize) -> usize {
-        let n_k = (self.positions.len() - lod) as u32;
+        let n_k = self.present(lod) as u32;
         let (mut lo, mut hi) = (0, self.total_triangles());
         while lo < hi {
             let mid = (lo + hi) / 2;
@@ -277,7 +328,11 @@ impl LodSource for MultilevelMesh {
     }
 
     fn max_lod(&self) -> usize {
-        self.positions.len() - self.roots
+        if self.present.is_empty() {
+            self.positions.len() - self.roots
+        } else {
+            self.present.len() - 1
+        }
     }
 
     /// O(log T × forest depth): the paper's walk toward the roots.
@@ -289,6 +344,10 @@ impl LodSource for MultilevelMesh {
         &self.positions
     }
 
+    fn properties(&self) -> &Properties {
+        &self.properties
+    }
+
     fn topology(&self) -> Topology {
         Topology::TriangleList
     }
@@ -297,7 +356,7 @@ impl LodSource for MultilevelMesh {
     /// writing only indices that change: O(lod + T_lod), allocation-free.
     fn set_lod(&mut self, lod: usize) -> usize {
         let lod = lod.min(self.max_lod());
-        let n_k = self.positions.len() - lod;
+        let n_k = self.present(lod);
         self.compress(lod);
         let (mut lo, mut hi) = (0, self.total_triangles());
         while lo < hi {
@@ -349,7 +408,8 @@ impl LodSource for MultilevelMesh {
 
     /// The paper's file (Figure 6) holds the same arrays: the structure's
     /// bytes plus a count per level, which with one level per contraction
-    /// is implicit (one vertex each); so the structure's size.
+    /// is implicit (one vertex each) or, with seams, the stored table; so
+    /// the structure's size.
     fn file_bytes(&self) -> usize {
         self.structure_bytes()
     }

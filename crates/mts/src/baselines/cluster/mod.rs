@@ -22,6 +22,12 @@
 //! "Variable resolution within one object") is [`ClusterTree::view_dependent`]:
 //! a cut of the tree chosen per node, drawn through its own pc-rep array,
 //! outside the shared LoD numbering.
+//!
+//! Properties: the tree clusters vertices, not points, so on a mesh with
+//! seams the vertices of one point (at distance 0) join first and one
+//! side's values stand for the other's from there on, as the paper's
+//! clustering of a split mesh would. Each vertex's values ride with it in
+//! the runtime and the stream.
 
 mod build;
 pub mod stream;
@@ -98,9 +104,10 @@ impl ClusterTree {
         // next join that involves that vertex folds it further.
         let n = mesh.vertex_count();
         let mut last_seen = vec![u32::MAX; n];
-        let mut parent_join = vec![u32::MAX; runtime.kept.len()];
-        for i in (0..runtime.kept.len()).rev() {
-            let (k, r) = (runtime.kept[i] as usize, n - 1 - i);
+        let max_lod = runtime.max_lod();
+        let mut parent_join = vec![u32::MAX; max_lod];
+        for i in (0..max_lod).rev() {
+            let (k, r) = (runtime.parent_of(n - 1 - i) as usize, n - 1 - i);
             parent_join[i] = last_seen[k];
             last_seen[k] = i as u32;
             last_seen[r] = i as u32;
@@ -150,22 +157,25 @@ impl ClusterTree {
     /// and two working arrays.
     #[must_use]
     pub fn view_dependent(&self, eye: Vec3, threshold: f32) -> Vec<[u32; 3]> {
-        let kept = &self.runtime.kept;
+        // The clustering moves one vertex per join: join `i` removes
+        // vertex `n - 1 - i`.
         let positions = &self.runtime.positions;
         let n = positions.len();
-        let mut unfolded = vec![false; kept.len()];
-        for i in (0..kept.len()).rev() {
+        let joins = self.runtime.max_lod();
+        let kept = |i: usize| self.runtime.parent_of(n - 1 - i) as usize;
+        let mut unfolded = vec![false; joins];
+        for i in (0..joins).rev() {
             let above = self.parent_join[i];
             let open = above == u32::MAX || unfolded[above as usize];
-            let distance = positions[kept[i] as usize].distance(eye);
+            let distance = positions[kept(i)].distance(eye);
             unfolded[i] = open && self.sizes[i] >= threshold * distance;
         }
-        let roots = n - kept.len();
+        let roots = n - joins;
         let mut pc: Vec<u32> = (0..n as u32).collect();
         for v in roots..n {
             let i = n - 1 - v;
             if !unfolded[i] {
-                pc[v] = pc[kept[i] as usize];
+                pc[v] = pc[kept(i)];
             }
         }
         self.triangles
@@ -198,6 +208,10 @@ impl LodSource for ClusterTree {
 
     fn positions(&self) -> &[Vec3] {
         self.runtime.positions()
+    }
+
+    fn properties(&self) -> &crate::mesh::Properties {
+        self.runtime.properties()
     }
 
     fn topology(&self) -> Topology {
