@@ -49,6 +49,6 @@ pub use error::{Error, Invalid, Place, Result};
 pub use lod::{LodSource, Topology};
 pub use mesh::Mesh;
 pub use model::{Extractor, MtsModel};
-pub use screen_error::{lod_for_screen_error, Projection};
+pub use screen_error::{lod_for_screen_error, lod_for_screen_error_of, Projection};
 pub use simplify::{simplify, Collapses, SimplifyOptions};
 pub use strip::{stripify, StripifyOptions, Strips};

@@ -17,6 +17,7 @@
 //! the threshold is a target rather than a guarantee; the scene benchmark
 //! measures the resulting image difference.
 
+use crate::lod::LodSource;
 use crate::simplify::Collapses;
 use glam::Vec3;
 
@@ -129,6 +130,26 @@ pub fn lod_for_screen_error(
     coarsest_within(collapses, limit)
 }
 
+/// [`lod_for_screen_error`] for any [`LodSource`] built from `collapses`:
+/// every source numbers its LoDs by the contractions of the sequence it
+/// was built from (`../shared/DESIGN.md`), so the sequence's error table
+/// answers for it too; the LoD is clamped to the source's `max_lod`.
+/// Discrete LoDs draw the coarsest stored level with at least the LoD's
+/// triangle count, simplified by meshoptimizer: at least as many
+/// triangles, with meshoptimizer's error rather than the sequence's.
+#[must_use]
+pub fn lod_for_screen_error_of(
+    source: &dyn LodSource,
+    collapses: &Collapses,
+    diagonal: f32,
+    scale: f32,
+    pixels_per_unit: f32,
+    pixel_threshold: f32,
+) -> usize {
+    lod_for_screen_error(collapses, diagonal, scale, pixels_per_unit, pixel_threshold)
+        .min(source.max_lod())
+}
+
 /// The coarsest LoD whose relative error is at most `limit` (binary search
 /// over the non-decreasing errors; LoD 0's is 0).
 fn coarsest_within(collapses: &Collapses, limit: f64) -> usize {
@@ -227,6 +248,21 @@ mod tests {
             viewport_height: 100.0,
         };
         assert_eq!(broken.pixels_per_unit(3.0), 0.0);
+    }
+
+    #[test]
+    fn a_baseline_built_from_the_sequence_gets_the_same_lod() {
+        let mesh = "torus:4k".parse::<Generated>().unwrap().build();
+        let c = simplify(&mesh, &SimplifyOptions::default()).collapses;
+        let pm = crate::baselines::ProgressiveMesh::new(&mesh, &c).unwrap();
+        for ppu in [1.0f32, 20.0, 200.0, 5000.0] {
+            let lod = lod_for_screen_error(&c, mesh.diagonal(), 1.0, ppu, 1.0);
+            assert_eq!(
+                lod_for_screen_error_of(&pm, &c, mesh.diagonal(), 1.0, ppu, 1.0),
+                lod
+            );
+            assert_eq!(pm.triangle_count(lod), c.triangle_count(lod));
+        }
     }
 
     #[test]
