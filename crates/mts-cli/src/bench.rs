@@ -196,12 +196,12 @@ fn scene_table(s: &mut String, rows: &[Scene]) {
         "\n## Scene: many instances of several models, LoD by screen-space error, shared buffers\n"
     );
     let _ = writeln!(s, "`mts bench render --scene`'s rows on Figure 6's adapter: instances of {} ({}) scaled to one radius on a ground plane, {}×{} pixels, a camera flying through the field ({} frames). Each visible instance gets the coarsest LoD whose recorded error projects within the threshold, and draws the shared buffer of its LoD bucket (10% fewer triangles a bucket), one instanced draw per (model, bucket). Update: cull, LoD choice, extractions, uploads; frame: update and draw. GPU: peak bucket buffers and transforms, against the sum of the models' full-detail strip buffers. Image: pixels covered by instances that differ at all from the same frame at full detail ({} frames of the path).\n", first.models, first.model_names.join(", "), first.width, first.height, first.frames, first.compared_frames);
-    let _ = writeln!(s, "| instances | px | visible | triangles (share of full) | draws | extractions / frame | update ms median / p99 | frame ms | CPU B / instance | GPU MB (× full strips) | buffers | pixels differing (by > {}/255) |", super::figure6::IMAGE_TOLERANCE);
+    let _ = writeln!(s, "| instances | px | visible | triangles (share of full) | draws | extractions / frame | update ms median / p99 | frame ms | CPU B / instance | GPU MB (× full strips) | buffers | pixels differing (by > {}/255; in coverage) |", super::figure6::IMAGE_TOLERANCE);
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.0} | {:.0} ({:.1}%) | {:.1} | {:.2} | {:.2} / {:.2} | {:.1} | {} | {:.2} ({:.2}×) | {} | {} ({}) |",
+            "| {} | {} | {:.0} | {:.0} ({:.1}%) | {:.1} | {:.2} | {:.2} / {:.2} | {:.1} | {} | {:.2} ({:.2}×) | {} | {} ({}; {}) |",
             r.instances,
             r.pixel_threshold,
             r.visible,
@@ -219,6 +219,8 @@ fn scene_table(s: &mut String, rows: &[Scene]) {
             r.differing_pixel_share
                 .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
             r.visibly_differing_pixel_share
+                .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
+            r.coverage_differing_pixel_share
                 .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
         );
     }
@@ -487,19 +489,17 @@ fn measure_scenes(
     let refs: Vec<(String, &MtsModel)> = models.iter().map(|(n, m)| (n.clone(), m)).collect();
     let mut rows = Vec::new();
     for &instances in counts {
-        for &pixel_error in thresholds {
-            progress(&format!(
-                "scene of {instances} instances of {} models at {pixel_error} px",
-                models.len()
-            ));
-            let spec = super::bench_render::SceneSpec {
-                instances,
-                pixel_error,
-                frames,
-                compared_frames: super::bench_render::SCENE_COMPARED_FRAMES,
-            };
-            rows.push(r.measure_scene(&refs, &spec)?);
-        }
+        progress(&format!(
+            "scene of {instances} instances of {} models at {thresholds:?} px",
+            models.len()
+        ));
+        let spec = super::bench_render::SceneSpec {
+            instances,
+            pixel_errors: thresholds,
+            frames,
+            compared_frames: super::bench_render::SCENE_COMPARED_FRAMES,
+        };
+        rows.extend(r.measure_scene(&refs, &spec)?);
     }
     Ok(rows)
 }

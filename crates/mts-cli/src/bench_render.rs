@@ -231,11 +231,11 @@ fn bench_scene(
 ) -> Result<Scene> {
     let spec = SceneSpec {
         instances: args.scene,
-        pixel_error: args.pixel_error,
+        pixel_errors: &[args.pixel_error],
         frames: args.frames,
         compared_frames: SCENE_COMPARED_FRAMES,
     };
-    let row = scene_row(gpu, target, config, models, &spec)?;
+    let row = scene_rows(gpu, target, config, models, &spec)?.remove(0);
     if !args.json {
         print_scene(&row);
     }
@@ -249,7 +249,7 @@ pub fn print_scene(r: &Scene) {
          ({:.1}%), {:.1} draws, {:.2} extractions a frame; update {:.2} ms median, {:.2} ms p99; \
          frame {:.2} ms; {} B CPU per instance, GPU {:.1} MB ({:.2} x the full-detail strips) \
          in {} buffers; {} of the covered pixels differ from full detail ({} by more than {} \
-         of 255)",
+         of 255, {} in coverage)",
         r.instances,
         r.models,
         r.pixel_threshold,
@@ -271,18 +271,20 @@ pub fn print_scene(r: &Scene) {
         r.visibly_differing_pixel_share
             .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
         crate::figure6::IMAGE_TOLERANCE,
+        r.coverage_differing_pixel_share
+            .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
     );
 }
 
 /// Frames of the path compared with full detail by `mts bench render`.
 pub const SCENE_COMPARED_FRAMES: usize = 3;
 
-/// What a scene row measures.
-pub struct SceneSpec {
+/// What the scene rows measure.
+pub struct SceneSpec<'t> {
     /// Instances (the models taken in turn).
     pub instances: usize,
-    /// The screen-space error allowed, in pixels.
-    pub pixel_error: f32,
+    /// The screen-space errors allowed, in pixels: a row each.
+    pub pixel_errors: &'t [f32],
     /// Frames along the camera path (timed).
     pub frames: usize,
     /// Frames of the path drawn also at full detail and compared (0 for
@@ -290,77 +292,43 @@ pub struct SceneSpec {
     pub compared_frames: usize,
 }
 
+/// The path's frames compared with full detail: `k + 0.5` of `n` along.
+fn compared_at(k: usize, n: usize) -> f32 {
+    (k as f32 + 0.5) / n as f32
+}
+
 /// `spec.instances` instances of `models` (the demo layout) seen along the
-/// fly-through path: one untimed frame at its start, then `spec.frames`
-/// frames along it, each an update (cull, LoD choice, extractions,
-/// uploads) and a draw, timed apart; memory at its peak; and on
-/// `spec.compared_frames` frames spread along the path the image of the
-/// instances (no ground) against the same frame at full detail: the share
-/// of the pixels either covers whose colour differs at all.
+/// fly-through path, a row per pixel error, each on a scene built afresh:
+/// one untimed frame at the path's start, then `spec.frames` frames along
+/// it, each an update (cull, LoD choice, extractions, uploads) and a draw,
+/// timed apart; memory at its peak; and on `spec.compared_frames` frames
+/// spread along the path the image of the instances (no ground) against
+/// the same frame at full detail (drawn once for all rows): the share of
+/// the pixels either covers whose colour differs at all, by more than
+/// [`crate::figure6::IMAGE_TOLERANCE`], and whose coverage differs.
 ///
 /// # Errors
 /// As the scene's construction, update and drawing.
-pub fn scene_row(
+pub fn scene_rows(
     gpu: &Gpu,
     target: &HeadlessTarget,
     config: &RendererConfig,
     models: &[(String, &mts::MtsModel)],
-    spec: &SceneSpec,
-) -> Result<Scene> {
+    spec: &SceneSpec<'_>,
+) -> Result<Vec<Scene>> {
     use crate::demo_scene::DemoScene;
     let (d, q) = (&gpu.device, &gpu.queue);
     let refs: Vec<&mts::MtsModel> = models.iter().map(|(_, m)| *m).collect();
-    let mut scene = DemoScene::new(d, q, config, &refs, spec.instances)?;
     let (width, height) = target.size();
     let (aspect, h) = (target.aspect(), height as f32);
-    let frames = spec.frames.max(1);
-    let at = |i: usize| i as f32 / (frames.max(2) - 1) as f32;
-    scene.update(d, q, &scene.path_camera(0.0, aspect), h, spec.pixel_error)?;
-    target.render(d, q, |pass| scene.draw(pass))?;
-    let (mut update, mut frame) = (Vec::with_capacity(frames), Vec::with_capacity(frames));
-    let mut sums = [0f64; 6];
-    let (mut buffers, mut gpu_bytes, mut extractions_max) = (0, 0, 0);
-    for i in 0..frames {
-        let camera = scene.path_camera(at(i), aspect);
-        let t = Instant::now();
-        let stats = scene.update(d, q, &camera, h, spec.pixel_error)?;
-        update.push(t.elapsed().as_secs_f64() * 1e3);
-        target.render(d, q, |pass| scene.draw(pass))?;
-        frame.push(t.elapsed().as_secs_f64() * 1e3);
-        let memory = scene.scene.memory();
-        buffers = buffers.max(memory.buffers);
-        gpu_bytes = gpu_bytes.max(memory.gpu_bytes());
-        extractions_max = extractions_max.max(stats.extractions);
-        for (sum, x) in sums.iter_mut().zip([
-            stats.visible,
-            stats.triangles,
-            stats.triangles_full_detail,
-            stats.indices_drawn,
-            stats.draws,
-            stats.extractions,
-        ]) {
-            *sum += x as f64;
+    let mut references = Vec::with_capacity(spec.compared_frames);
+    {
+        let mut full = DemoScene::new(d, q, config, &refs, spec.instances)?;
+        for k in 0..spec.compared_frames {
+            let camera = full.path_camera(compared_at(k, spec.compared_frames), aspect);
+            full.update(d, q, &camera, h, 0.0)?;
+            references.push(target.render_image(d, q, |pass| full.scene.draw(pass))?);
         }
-    }
-    let memory = scene.scene.memory();
-    let mean = |x: f64| x / frames as f64;
-    let percentile = |mut v: Vec<f64>, p: f64| {
-        v.sort_by(f64::total_cmp);
-        v[((v.len() - 1) as f64 * p).round() as usize]
-    };
-    // Full detail on a few frames of the path, instances only.
-    let (mut differing, mut visibly, mut covered) = (0f64, 0f64, 0f64);
-    for k in 0..spec.compared_frames {
-        let camera = scene.path_camera((k as f32 + 0.5) / spec.compared_frames as f32, aspect);
-        scene.update(d, q, &camera, h, spec.pixel_error)?;
-        let lod = target.render_image(d, q, |pass| scene.scene.draw(pass))?;
-        scene.update(d, q, &camera, h, 0.0)?;
-        let full = target.render_image(d, q, |pass| scene.scene.draw(pass))?;
-        let diff = full.difference(&lod, 0);
-        differing += diff.share * diff.pixels as f64;
-        covered += diff.pixels as f64;
-        let visible = full.difference(&lod, crate::figure6::IMAGE_TOLERANCE);
-        visibly += visible.share * visible.pixels as f64;
     }
     let full_detail_strip_bytes = models
         .iter()
@@ -375,32 +343,86 @@ pub fn scene_row(
             bytes * ex.indices_sent() as u64
         })
         .sum();
-    Ok(Scene {
-        models: models.len() as u64,
-        model_names: models.iter().map(|(n, _)| n.clone()).collect(),
-        instances: spec.instances as u64,
-        width,
-        height,
-        pixel_threshold: f64::from(spec.pixel_error),
-        frames: frames as u64,
-        visible: mean(sums[0]),
-        triangles_drawn: mean(sums[1]),
-        triangles_full_detail: mean(sums[2]),
-        indices_drawn: mean(sums[3]),
-        draws: mean(sums[4]),
-        extractions_per_frame: mean(sums[5]),
-        extractions_max: extractions_max as u64,
-        cpu_bytes_per_instance: memory.cpu_bytes_per_instance() as u64,
-        cpu_shared_bytes: memory.cpu_shared_bytes as u64,
-        gpu_bytes: gpu_bytes as u64,
-        gpu_vertex_bytes: memory.gpu_vertex_bytes as u64,
-        full_detail_strip_bytes,
-        buffers: buffers as u64,
-        update_ms_median: percentile(update.clone(), 0.5),
-        update_ms_p99: percentile(update, 0.99),
-        frame_ms_median: percentile(frame, 0.5),
-        compared_frames: spec.compared_frames as u64,
-        differing_pixel_share: (covered > 0.0).then(|| differing / covered),
-        visibly_differing_pixel_share: (covered > 0.0).then(|| visibly / covered),
-    })
+    let frames = spec.frames.max(1);
+    let at = |i: usize| i as f32 / (frames.max(2) - 1) as f32;
+    let mut rows = Vec::with_capacity(spec.pixel_errors.len());
+    for &pixel_error in spec.pixel_errors {
+        let mut scene = DemoScene::new(d, q, config, &refs, spec.instances)?;
+        scene.update(d, q, &scene.path_camera(0.0, aspect), h, pixel_error)?;
+        target.render(d, q, |pass| scene.draw(pass))?;
+        let (mut update, mut frame) = (Vec::with_capacity(frames), Vec::with_capacity(frames));
+        let mut sums = [0f64; 6];
+        let (mut buffers, mut gpu_bytes, mut extractions_max) = (0, 0, 0);
+        for i in 0..frames {
+            let camera = scene.path_camera(at(i), aspect);
+            let t = Instant::now();
+            let stats = scene.update(d, q, &camera, h, pixel_error)?;
+            update.push(t.elapsed().as_secs_f64() * 1e3);
+            target.render(d, q, |pass| scene.draw(pass))?;
+            frame.push(t.elapsed().as_secs_f64() * 1e3);
+            let memory = scene.scene.memory();
+            buffers = buffers.max(memory.buffers);
+            gpu_bytes = gpu_bytes.max(memory.gpu_bytes());
+            extractions_max = extractions_max.max(stats.extractions);
+            for (sum, x) in sums.iter_mut().zip([
+                stats.visible,
+                stats.triangles,
+                stats.triangles_full_detail,
+                stats.indices_drawn,
+                stats.draws,
+                stats.extractions,
+            ]) {
+                *sum += x as f64;
+            }
+        }
+        let memory = scene.scene.memory();
+        let mean = |x: f64| x / frames as f64;
+        let percentile = |mut v: Vec<f64>, p: f64| {
+            v.sort_by(f64::total_cmp);
+            v[((v.len() - 1) as f64 * p).round() as usize]
+        };
+        let mut pixels = [0f64; 4];
+        for (k, full) in references.iter().enumerate() {
+            let camera = scene.path_camera(compared_at(k, spec.compared_frames), aspect);
+            scene.update(d, q, &camera, h, pixel_error)?;
+            let lod = target.render_image(d, q, |pass| scene.scene.draw(pass))?;
+            let exact = full.difference(&lod, 0);
+            let visible = full.difference(&lod, crate::figure6::IMAGE_TOLERANCE);
+            pixels[0] += exact.pixels as f64;
+            pixels[1] += exact.share * exact.pixels as f64;
+            pixels[2] += visible.share * visible.pixels as f64;
+            pixels[3] += exact.coverage_changed as f64;
+        }
+        let share = |x: f64| (pixels[0] > 0.0).then(|| x / pixels[0]);
+        rows.push(Scene {
+            models: models.len() as u64,
+            model_names: models.iter().map(|(n, _)| n.clone()).collect(),
+            instances: spec.instances as u64,
+            width,
+            height,
+            pixel_threshold: f64::from(pixel_error),
+            frames: frames as u64,
+            visible: mean(sums[0]),
+            triangles_drawn: mean(sums[1]),
+            triangles_full_detail: mean(sums[2]),
+            indices_drawn: mean(sums[3]),
+            draws: mean(sums[4]),
+            extractions_per_frame: mean(sums[5]),
+            extractions_max: extractions_max as u64,
+            cpu_bytes_per_instance: memory.cpu_bytes_per_instance() as u64,
+            cpu_shared_bytes: memory.cpu_shared_bytes as u64,
+            gpu_bytes: gpu_bytes as u64,
+            gpu_vertex_bytes: memory.gpu_vertex_bytes as u64,
+            full_detail_strip_bytes,
+            buffers: buffers as u64,
+            update_ms_median: percentile(update.clone(), 0.5),
+            update_ms_p99: percentile(update, 0.99),
+            frame_ms_median: percentile(frame, 0.5),
+            compared_frames: spec.compared_frames as u64,
+            differing_pixel_share: share(pixels[1]),
+            visibly_differing_pixel_share: share(pixels[2]),
+            coverage_differing_pixel_share: share(pixels[3]),
+        });
+    }
+    Ok(rows)
 }

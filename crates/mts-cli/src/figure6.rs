@@ -256,16 +256,16 @@ impl Renderer {
         })
     }
 
-    /// A scene row (see `mts bench render --scene`) of `models`.
+    /// Scene rows (see `mts bench render --scene`) of `models`.
     ///
     /// # Errors
-    /// As [`super::bench_render::scene_row`].
+    /// As [`super::bench_render::scene_rows`].
     pub fn measure_scene(
         &self,
         models: &[(String, &MtsModel)],
-        spec: &super::bench_render::SceneSpec,
-    ) -> Result<Scene> {
-        super::bench_render::scene_row(&self.gpu, &self.target, &self.config, models, spec)
+        spec: &super::bench_render::SceneSpec<'_>,
+    ) -> Result<Vec<Scene>> {
+        super::bench_render::scene_rows(&self.gpu, &self.target, &self.config, models, spec)
     }
 
     /// Figure 6 rows of one baseline (see the module documentation).

@@ -340,6 +340,9 @@ pub struct Scene {
     /// The same, counting only pixels whose colour moved by more than
     /// [`crate::figure6::IMAGE_TOLERANCE`] of 255 in a channel.
     pub visibly_differing_pixel_share: Option<f64>,
+    /// The same, counting only pixels covered by instances in one image
+    /// and not the other (silhouettes that moved).
+    pub coverage_differing_pixel_share: Option<f64>,
 }
 
 impl Results {

@@ -66,21 +66,24 @@ impl Image {
     #[must_use]
     pub fn difference(&self, other: &Image, tolerance: u8) -> Difference {
         if (self.width, self.height) != (other.width, other.height) {
+            let pixels = (self.width * self.height).max(other.width * other.height) as usize;
             return Difference {
-                pixels: (self.width * self.height).max(other.width * other.height) as usize,
+                pixels,
                 share: 1.0,
                 rms: 1.0,
+                coverage_changed: pixels,
             };
         }
         let (Some(ca), Some(cb)) = (self.rgba.get(..4), other.rgba.get(..4)) else {
             return Difference::default();
         };
-        let (mut pixels, mut differing, mut sum) = (0usize, 0usize, 0f64);
+        let (mut pixels, mut differing, mut sum, mut coverage) = (0usize, 0usize, 0f64, 0usize);
         for (a, b) in self.rgba.chunks_exact(4).zip(other.rgba.chunks_exact(4)) {
             if a == ca && b == cb {
                 continue;
             }
             pixels += 1;
+            coverage += usize::from((a == ca) != (b == cb));
             let mut most = 0u8;
             for c in 0..3 {
                 let d = a[c].abs_diff(b[c]);
@@ -96,6 +99,7 @@ impl Image {
             pixels,
             share: differing as f64 / pixels as f64,
             rms: (sum / (3 * pixels) as f64).sqrt(),
+            coverage_changed: coverage,
         }
     }
 
@@ -129,6 +133,9 @@ pub struct Difference {
     pub share: f64,
     /// RMS of the RGB difference over those pixels, in 0..=1.
     pub rms: f64,
+    /// Of those, the pixels that show the model in one image only (the
+    /// silhouettes moved).
+    pub coverage_changed: usize,
 }
 
 /// A colour texture ([`COLOR_FORMAT`]) and depth texture ([`DEPTH_FORMAT`])
@@ -407,6 +414,7 @@ mod tests {
         let other = image([[202, 200, 200], [224, 64, 64], [10, 10, 10]]);
         let d = reference.difference(&other, 8);
         assert_eq!(d.pixels, 3);
+        assert_eq!(d.coverage_changed, 1);
         assert!((d.share - 2.0 / 3.0).abs() < 1e-12, "{d:?}");
         let sum = (2f64 / 255.0).powi(2) + (160f64 / 255.0).powi(2) + 3.0 * (10f64 / 255.0).powi(2);
         assert!((d.rms - (sum / 9.0).sqrt()).abs() < 1e-12, "{d:?}");
@@ -416,7 +424,8 @@ mod tests {
             Difference {
                 pixels: 2,
                 share: 0.0,
-                rms: 0.0
+                rms: 0.0,
+                coverage_changed: 0
             }
         );
         let other_size = Image {
