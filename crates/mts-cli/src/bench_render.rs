@@ -323,7 +323,7 @@ pub fn scene_rows(
     let (aspect, h) = (target.aspect(), height as f32);
     let mut references = Vec::with_capacity(spec.compared_frames);
     {
-        let mut full = DemoScene::new(d, q, config, &refs, spec.instances)?;
+        let mut full = DemoScene::new(d, q, config, &refs, spec.instances, &Default::default())?;
         for k in 0..spec.compared_frames {
             let camera = full.path_camera(compared_at(k, spec.compared_frames), aspect);
             full.update(d, q, &camera, h, 0.0)?;
@@ -347,7 +347,7 @@ pub fn scene_rows(
     let at = |i: usize| i as f32 / (frames.max(2) - 1) as f32;
     let mut rows = Vec::with_capacity(spec.pixel_errors.len());
     for &pixel_error in spec.pixel_errors {
-        let mut scene = DemoScene::new(d, q, config, &refs, spec.instances)?;
+        let mut scene = DemoScene::new(d, q, config, &refs, spec.instances, &Default::default())?;
         scene.update(d, q, &scene.path_camera(0.0, aspect), h, pixel_error)?;
         target.render(d, q, |pass| scene.draw(pass))?;
         let (mut update, mut frame) = (Vec::with_capacity(frames), Vec::with_capacity(frames));

@@ -26,20 +26,22 @@ pub struct DemoScene<'m> {
 }
 
 impl<'m> DemoScene<'m> {
-    /// Places `count` instances of `models` (taken in turn) on a square
+    /// Places `count` instances of `models` (taken in turn, drawn with
+    /// `appearance`) on a square
     /// grid on the plane y = 0, each scaled to a bounding radius of 1,
     /// resting on the plane and turned about +y by a fixed pseudo-random
     /// angle, [`SPACING`] radii apart, with a ground quad under them.
     ///
     /// # Errors
-    /// As [`InstancedScene::add_model`] and [`InstancedScene::add_instance`];
-    /// no models or no instances.
+    /// As [`InstancedScene::add_model_with`] and
+    /// [`InstancedScene::add_instance`]; no models or no instances.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         config: &RendererConfig,
         models: &[&'m MtsModel],
         count: usize,
+        appearance: &mts_render::Appearance,
     ) -> Result<DemoScene<'m>> {
         if count == 0 || models.is_empty() {
             return Err(mts::Error::InvalidArgument(
@@ -51,7 +53,10 @@ impl<'m> DemoScene<'m> {
         // rests its lowest point on the plane.
         let mut placed = Vec::with_capacity(models.len());
         for model in models {
-            let id = scene.add_model(device, queue, model)?;
+            let id = scene.add_model_with(device, queue, model, appearance)?;
+            for w in scene.warnings(id) {
+                eprintln!("{w}");
+            }
             let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
             let radius = ((mts::mesh::diagonal_of(min, max) * 0.5) as f32).max(f32::MIN_POSITIVE);
             let centre = (min + max) * 0.5;

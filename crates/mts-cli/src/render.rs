@@ -98,7 +98,7 @@ pub struct RenderArgs {
     /// Texture the model with a checker (shows UV distortion) instead of
     /// its own texture; needs texture coordinates (`--properties`, or a
     /// model built with them).
-    #[arg(long, conflicts_with = "scene")]
+    #[arg(long)]
     checker: bool,
     /// Draw N instances of the model on a ground plane instead (each at
     /// the coarsest LoD within --pixel-error, drawn from buffers shared
@@ -245,7 +245,10 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     let config = RendererConfig::headless(report.strip_mode);
     let (device, queue) = (&gpu.device, &gpu.queue);
     let target = HeadlessTarget::new(device, width, height)?;
-    let mut scene = DemoScene::new(device, queue, &config, &[model], count)?;
+    let appearance = mts_render::Appearance {
+        checker: args.checker,
+    };
+    let mut scene = DemoScene::new(device, queue, &config, &[model], count, &appearance)?;
     let camera = scene.overview_camera(target.aspect());
     let pixel_error = args.pixel_error;
     let t = Instant::now();
@@ -348,7 +351,10 @@ pub fn view(args: &ViewArgs) -> Result<()> {
     use crate::viewer::{run, ViewerContent};
     let (name, model) = args.source.model()?;
     let content = match args.scene {
-        Some(n) => ViewerContent::Scene(n),
+        Some(count) => ViewerContent::Scene {
+            count,
+            checker: args.checker,
+        },
         None => ViewerContent::Model {
             checker: args.checker,
         },

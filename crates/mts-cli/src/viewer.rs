@@ -40,8 +40,14 @@ pub enum ViewerContent {
         /// Show the checker texture.
         checker: bool,
     },
-    /// This many instances of it on a ground plane.
-    Scene(usize),
+    /// `count` instances of it on a ground plane (with the checker
+    /// texture when `checker` is set).
+    Scene {
+        /// Instances.
+        count: usize,
+        /// Show the checker texture.
+        checker: bool,
+    },
 }
 
 /// What a viewer session did, for a closing line.
@@ -328,9 +334,16 @@ impl<'m> State<'m> {
                 };
                 (drawn, (lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-6))
             }
-            ViewerContent::Scene(n) => {
+            ViewerContent::Scene { count, checker } => {
                 // Stitched on backends that ignore primitive restart.
-                let scene = DemoScene::new(&device, &queue, &renderer_config, &[model], n)?;
+                let scene = DemoScene::new(
+                    &device,
+                    &queue,
+                    &renderer_config,
+                    &[model],
+                    count,
+                    &mts_render::Appearance { checker },
+                )?;
                 let (lo, hi) = scene
                     .instances
                     .iter()
@@ -361,7 +374,7 @@ impl<'m> State<'m> {
                 distance: 3.0,
             },
             ratio: 1.0,
-            auto: matches!(content, ViewerContent::Scene(_)),
+            auto: matches!(content, ViewerContent::Scene { .. }),
             dragging: false,
             last_cursor: None,
             extract_us: 0.0,

@@ -312,16 +312,27 @@ impl<'m> InstancedScene<'m> {
         queue: &wgpu::Queue,
         model: &'m MtsModel,
     ) -> Result<ModelId> {
+        self.add_model_with(device, queue, model, &Appearance::default())
+    }
+
+    /// [`InstancedScene::add_model`] drawn with `appearance` (e.g. the
+    /// checker texture over the model's UVs; what cannot be drawn is in
+    /// [`InstancedScene::warnings`]).
+    ///
+    /// # Errors
+    /// As [`InstancedScene::add_model`].
+    pub fn add_model_with(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        model: &'m MtsModel,
+        appearance: &Appearance,
+    ) -> Result<ModelId> {
         if self.models.len() >= u32::MAX as usize {
             return Err(Error::InvalidArgument("too many models".into()));
         }
-        let renderer = StripRenderer::for_model_with(
-            device,
-            queue,
-            &self.config,
-            model,
-            &Appearance::default(),
-        )?;
+        let renderer =
+            StripRenderer::for_model_with(device, queue, &self.config, model, appearance)?;
         let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
         let diagonal = mts::mesh::diagonal_of(min, max) as f32;
         let radius = (diagonal * 0.5).max(f32::MIN_POSITIVE);
@@ -468,6 +479,15 @@ impl<'m> InstancedScene<'m> {
     pub fn wanted_lod_of(&self, id: InstanceId) -> Option<usize> {
         let slot = self.slot(id)?;
         (slot.bucket != NONE).then_some(slot.lod as usize)
+    }
+
+    /// What the renderer of `model` could not draw (a missing or corrupt
+    /// texture), as [`StripRenderer::warnings`].
+    #[must_use]
+    pub fn warnings(&self, model: ModelId) -> &[String] {
+        self.models
+            .get(model.0 as usize)
+            .map_or(&[], |e| e.renderer.warnings())
     }
 
     /// Where the scene's memory goes now.

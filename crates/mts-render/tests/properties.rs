@@ -426,3 +426,53 @@ fn spot_with_the_checker_covers_what_it_covers_untextured() {
         );
     });
 }
+
+/// The instanced scene draws the models' properties: with the checker,
+/// instances of a torus with UVs change colour over most of the pixels
+/// they cover, and cover exactly the same pixels, on every backend.
+#[test]
+fn instanced_scene_draws_the_checker() {
+    use mts::mesh::generate::Generated;
+    let mesh = "torus:2k"
+        .parse::<Generated>()
+        .unwrap()
+        .build_with_properties();
+    let (model, _, _) = mts::model::build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});
+    let size = mesh.diagonal();
+    on_each_backend(|gpu, what| {
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let config = RendererConfig::headless(gpu.report().strip_mode);
+        let target = HeadlessTarget::new(d, 200, 150).unwrap();
+        let mut images = Vec::new();
+        for checker in [false, true] {
+            let mut scene = mts_render::InstancedScene::new(&config);
+            let id = scene
+                .add_model_with(d, q, &model, &Appearance { checker })
+                .unwrap();
+            assert_eq!(scene.warnings(id), &[] as &[String], "{what}");
+            for i in 0..4 {
+                let at = Vec3::new((i % 2) as f32, 0.0, (i / 2) as f32) * size;
+                scene.add_instance(id, Mat4::from_translation(at)).unwrap();
+            }
+            let camera = Camera::looking(
+                Vec3::new(0.5, 1.2, 1.8) * size,
+                Vec3::new(0.5, 0.0, 0.5) * size,
+                target.aspect(),
+                0.01 * size,
+                100.0 * size,
+            );
+            let stats = scene.update(d, q, &camera, 150.0, 1.0).unwrap();
+            assert_eq!(stats.visible, 4, "{what}");
+            images.push(target.render_image(d, q, |pass| scene.draw(pass)).unwrap());
+        }
+        let covered = images[0].foreground_pixels();
+        assert!(covered > 5_000, "{what}: {covered}");
+        let d = images[0].difference(&images[1], 8);
+        assert_eq!(d.coverage_changed, 0, "{what}: coverage");
+        assert!(
+            d.share > 0.5,
+            "{what}: the checker changes {} of {covered} pixels",
+            d.share
+        );
+    });
+}
