@@ -219,6 +219,9 @@ pub struct Method {
     pub file_bytes: u64,
     pub file_ratio_to_raw_u16: f64,
     pub us_per_change: BTreeMap<String, f64>,
+    /// MTS only: the same requests, each LoD extracted from scratch (every
+    /// strip walked), against which `us_per_change` shows coherence.
+    pub us_per_change_scratch: Option<BTreeMap<String, f64>>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
