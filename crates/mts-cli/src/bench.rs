@@ -1008,7 +1008,7 @@ pub fn report(results: &Results) -> String {
         s,
         "\n### Table 2, every method: microseconds per LoD change\n"
     );
-    let _ = writeln!(s, "Each method through `LodSource::set_lod` (MTS: the coherent extractor; "from scratch": every strip walked at each request, with the scratch/coherent ratio), the same sequences over its own LoD range, in one run. The cluster tree's LoDs are its own joins; discrete LoDs only switch buffers.\n");
+    let _ = writeln!(s, "Each method through `LodSource::set_lod` (MTS: the coherent extractor; from scratch: every strip walked at each request, with the scratch/coherent ratio), the same sequences over its own LoD range, in one run. The cluster tree's LoDs are its own joins; discrete LoDs only switch buffers.\n");
     let _ = writeln!(s, "| model | method | linear | exponential | random |");
     let _ = writeln!(s, "|---|---|---|---|---|");
     for r in models {
