@@ -157,6 +157,25 @@ impl<'m> DemoScene<'m> {
     }
 }
 
+/// The models of `--scene-with`: each mesh file loaded and built with the
+/// default options, named by its path.
+///
+/// # Errors
+/// When a file cannot be loaded.
+pub fn load_models(paths: &[std::path::PathBuf]) -> anyhow::Result<Vec<(String, MtsModel)>> {
+    use anyhow::Context;
+    paths
+        .iter()
+        .map(|p| {
+            let (mesh, _) = mts::mesh::io::load(p, Default::default())
+                .with_context(|| format!("cannot load {}", p.display()))?;
+            let (model, _, _) =
+                mts::model::build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});
+            Ok((p.display().to_string(), model))
+        })
+        .collect()
+}
+
 /// A fixed pseudo-random number in 0..1 from `i` (integer hash).
 fn hash01(i: u32) -> f32 {
     let mut x = i.wrapping_mul(0x9E37_79B9) ^ 0x85EB_CA6B;

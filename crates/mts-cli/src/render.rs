@@ -107,6 +107,10 @@ pub struct RenderArgs {
           conflicts_with_all = ["lod", "triangles", "ratio", "method"],
           allow_negative_numbers = true, value_parser = crate::count_in::<1, { 1 << 20 }>)]
     scene: Option<usize>,
+    /// With --scene: more models (OBJ/PLY meshes), their instances taken
+    /// in turn with the command's model.
+    #[arg(long, value_name = "MESH", num_args = 1.., requires = "scene")]
+    scene_with: Vec<PathBuf>,
     /// With --scene: the screen-space error allowed, in pixels (0 draws
     /// every instance at full detail).
     #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR, requires = "scene",
@@ -248,7 +252,10 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     let appearance = mts_render::Appearance {
         checker: args.checker,
     };
-    let mut scene = DemoScene::new(device, queue, &config, &[model], count, &appearance)?;
+    let others = crate::demo_scene::load_models(&args.scene_with)?;
+    let mut models = vec![model];
+    models.extend(others.iter().map(|(_, m)| m));
+    let mut scene = DemoScene::new(device, queue, &config, &models, count, &appearance)?;
     let camera = scene.overview_camera(target.aspect());
     let pixel_error = args.pixel_error;
     let t = Instant::now();
