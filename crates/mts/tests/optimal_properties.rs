@@ -18,26 +18,6 @@ fn optimal() -> SimplifyOptions {
     }
 }
 
-/// Edges between points used by one triangle only, and the points that
-/// carry more than one vertex, of `mesh`.
-fn borders_and_seam_points(mesh: &Mesh) -> (usize, usize) {
-    let p = &mesh.properties;
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-    for t in &mesh.triangles {
-        let t = t.map(|v| p.position_id(v));
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    let borders = edges.values().filter(|&&n| n == 1).count();
-    let mut vertices_of: HashMap<u32, u32> = HashMap::new();
-    for v in 0..mesh.vertex_count() as u32 {
-        *vertices_of.entry(p.position_id(v)).or_default() += 1;
-    }
-    (borders, vertices_of.values().filter(|&&n| n > 1).count())
-}
-
 /// The checks every LoD in `lods` must pass: the mesh at it is valid (its
 /// properties one per vertex, finite, colours in range, one position per
 /// point), is the oracle's, has unit normals, tears no point, and has no
@@ -51,7 +31,7 @@ fn check_lods(
     check_borders: bool,
 ) {
     c.validate().unwrap();
-    let (borders0, seams0) = borders_and_seam_points(mesh);
+    let (borders0, seams0) = common::borders_and_seam_points(mesh);
     let all = c
         .properties(mesh)
         .expect("created vertices have properties");
@@ -106,7 +86,7 @@ fn check_lods(
                 assert_eq!(was, now, "{name} at {lod}: a point tore");
             }
         }
-        let (borders, seams) = borders_and_seam_points(&at);
+        let (borders, seams) = common::borders_and_seam_points(&at);
         assert!(
             seams <= seams0,
             "{name} at {lod}: {seams} seam points, {seams0} before"
@@ -169,7 +149,7 @@ fn a_seamed_torus_keeps_its_seams_closed_with_optimal_placement() {
     let lods: Vec<usize> = (0..=c.max_lod()).step_by(37).chain([c.max_lod()]).collect();
     check_lods(&mesh, &c, lods, "torus", true);
     check_created_properties(&mesh, &c);
-    let (_, seams0) = borders_and_seam_points(&mesh);
+    let (_, seams0) = common::borders_and_seam_points(&mesh);
     assert!(seams0 > 0);
 }
 

@@ -5,27 +5,6 @@ mod common;
 
 use mts::mesh::Mesh;
 use mts::{simplify, SimplifyOptions};
-use std::collections::HashMap;
-
-/// Edges between points (not vertices) used by one triangle only, and the
-/// points that carry more than one vertex, of `mesh` at a LoD.
-fn borders_and_seam_points(mesh: &Mesh) -> (usize, usize) {
-    let p = &mesh.properties;
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-    for t in &mesh.triangles {
-        let t = t.map(|v| p.position_id(v));
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    let borders = edges.values().filter(|&&n| n == 1).count();
-    let mut vertices_of: HashMap<u32, u32> = HashMap::new();
-    for v in 0..mesh.vertex_count() as u32 {
-        *vertices_of.entry(p.position_id(v)).or_default() += 1;
-    }
-    (borders, vertices_of.values().filter(|&&n| n > 1).count())
-}
 
 #[test]
 fn seams_stay_closed_and_never_multiply() {
@@ -33,7 +12,7 @@ fn seams_stay_closed_and_never_multiply() {
         let Some(mesh) = common::model_with_properties(name) else {
             return;
         };
-        let (borders0, seam_points0) = borders_and_seam_points(&mesh);
+        let (borders0, seam_points0) = common::borders_and_seam_points(&mesh);
         // Suzanne's normals are one per position: no seam there.
         assert_eq!(seam_points0 > 0, name != "suzanne.obj", "{name}");
         let s = simplify(&mesh, &SimplifyOptions::default());
@@ -43,7 +22,7 @@ fn seams_stay_closed_and_never_multiply() {
             let lod = c.lod_for_ratio(share);
             let at = c.mesh_at(&mesh, lod);
             at.validate().unwrap();
-            let (borders, seam_points) = borders_and_seam_points(&at);
+            let (borders, seam_points) = common::borders_and_seam_points(&at);
             assert!(
                 borders <= borders0,
                 "{name} at {share}: {borders} border edges, {borders0} in the input"
@@ -156,7 +135,7 @@ fn corrupt_version_2_files_are_errors_or_valid_models() {
     use mts::model::{build_from_mesh, format::seal};
     use mts::MtsModel;
     let mesh = seamed_grid();
-    let (_, seam_points) = borders_and_seam_points(&mesh);
+    let (_, seam_points) = common::borders_and_seam_points(&mesh);
     assert!(seam_points > 5);
     let (model, _, _) = build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});
     assert!(model.collapses().has_companions());
@@ -200,14 +179,14 @@ fn generated_properties_are_valid_and_the_torus_seams_stay_closed() {
         let p = &mesh.properties;
         assert!(p.colors.is_some() && p.normals.is_some(), "{name}");
         assert_eq!(p.uvs.is_some(), !name.starts_with("icosphere"), "{name}");
-        let (borders0, seam_points0) = borders_and_seam_points(&mesh);
+        let (borders0, seam_points0) = common::borders_and_seam_points(&mesh);
         // The torus's two seam loops meet at one point.
         assert_eq!(seam_points0 > 0, name.starts_with("torus"), "{name}");
         let s = simplify(&mesh, &SimplifyOptions::default());
         for share in [0.1, 0.01] {
             let at = s.collapses.mesh_at(&mesh, s.collapses.lod_for_ratio(share));
             at.validate().unwrap();
-            let (borders, seam_points) = borders_and_seam_points(&at);
+            let (borders, seam_points) = common::borders_and_seam_points(&at);
             assert!(
                 borders <= borders0 && seam_points <= seam_points0,
                 "{name} at {share}"

@@ -111,3 +111,24 @@ pub fn model_with_properties(name: &str) -> Option<Mesh> {
     };
     Some(load(&path, options).unwrap().0)
 }
+
+/// Edges between points (not vertices) used by one triangle only, and the
+/// points that carry more than one vertex, of `mesh` (at a LoD).
+pub fn borders_and_seam_points(mesh: &Mesh) -> (usize, usize) {
+    use std::collections::HashMap;
+    let p = &mesh.properties;
+    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in &mesh.triangles {
+        let t = t.map(|v| p.position_id(v));
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let borders = edges.values().filter(|&&n| n == 1).count();
+    let mut vertices_of: HashMap<u32, u32> = HashMap::new();
+    for v in 0..mesh.vertex_count() as u32 {
+        *vertices_of.entry(p.position_id(v)).or_default() += 1;
+    }
+    (borders, vertices_of.values().filter(|&&n| n > 1).count())
+}
