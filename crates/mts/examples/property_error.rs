@@ -73,6 +73,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..LoadOptions::default()
     };
     for name in MODELS {
+        if !dir.join(name).exists() {
+            println!("{name:<11} not in {}: skipped", dir.display());
+            continue;
+        }
         let (mesh, _) = load(&dir.join(name), options)?;
         let collapses = mts::simplify(&mesh, &ours).collapses;
         for share in SHARES {
