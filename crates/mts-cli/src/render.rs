@@ -340,9 +340,14 @@ pub struct ViewArgs {
     /// An .mts model, or an OBJ/PLY mesh (the model is built on the fly).
     #[command(flatten)]
     source: MeshSource,
-    /// Show N instances on a ground plane instead (1000 when N is left out).
+    /// Show N instances on a ground plane instead (1000 when N is left
+    /// out); `F` flies through them.
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000")]
     scene: Option<usize>,
+    /// With --scene: more models (OBJ/PLY meshes), their instances taken
+    /// in turn with the command's model.
+    #[arg(long, value_name = "MESH", num_args = 1.., requires = "scene")]
+    scene_with: Vec<PathBuf>,
     /// Quit after this many frames (scripted runs).
     #[arg(long)]
     frames: Option<u64>,
@@ -366,7 +371,15 @@ pub fn view(args: &ViewArgs) -> Result<()> {
             checker: args.checker,
         },
     };
-    let report = run(&model, content, &format!("mts view: {name}"), args.frames)?;
+    let others = crate::demo_scene::load_models(&args.scene_with)?;
+    let others: Vec<&MtsModel> = others.iter().map(|(_, m)| m).collect();
+    let report = run(
+        &model,
+        &others,
+        content,
+        &format!("mts view: {name}"),
+        args.frames,
+    )?;
     println!(
         "{name}: {} frames in {:.1} s on {}; last: {}",
         report.frames, report.seconds, report.adapter, report.last_status

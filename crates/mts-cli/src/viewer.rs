@@ -5,7 +5,8 @@
 //! to move closer or farther; the mouse wheel, `Up`/`Down` or `+`/`-`
 //! change the LoD continuously (10% of the triangles per step); `A` toggles
 //! the automatic mode, which picks the coarsest LoD whose error projects
-//! within one pixel ([`mts::lod_for_screen_error`]); `Escape` quits. The
+//! within one pixel ([`mts::lod_for_screen_error`]); in a scene `F` flies
+//! along the demo's path and back to orbiting; `Escape` quits. The
 //! title shows triangles, indices sent, the last extraction's microseconds
 //! and frames per second.
 
@@ -30,6 +31,8 @@ const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const LOD_STEP: f64 = 1.1;
 /// Seconds between title updates.
 const TITLE_PERIOD: f64 = 0.5;
+/// Seconds of one flight along the scene's path (`F`).
+const FLIGHT_SECONDS: f32 = 40.0;
 
 /// What the viewer shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -72,6 +75,7 @@ pub struct ViewerReport {
 /// errors of [`StripRenderer::for_model`] and [`DemoScene::new`].
 pub fn run(
     model: &MtsModel,
+    others: &[&MtsModel],
     content: ViewerContent,
     title: &str,
     max_frames: Option<u64>,
@@ -80,6 +84,7 @@ pub fn run(
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         model,
+        others,
         content,
         title: title.to_owned(),
         max_frames,
@@ -105,6 +110,8 @@ pub fn run(
 
 struct App<'m> {
     model: &'m MtsModel,
+    /// More models of the scene (instances taken in turn with `model`).
+    others: &'m [&'m MtsModel],
     content: ViewerContent,
     title: String,
     max_frames: Option<u64>,
@@ -125,6 +132,9 @@ struct State<'m> {
     orbit: Orbit,
     /// Share of the triangles asked for in manual mode (0..1].
     ratio: f64,
+    /// In a scene, when set: flying along the demo's path since then
+    /// (`F` toggles), instead of orbiting.
+    flying: Option<Instant>,
     auto: bool,
     dragging: bool,
     last_cursor: Option<(f64, f64)>,
@@ -183,7 +193,13 @@ impl ApplicationHandler for App<'_> {
         if self.state.is_some() {
             return;
         }
-        match State::new(event_loop, self.model, self.content, &self.title) {
+        match State::new(
+            event_loop,
+            self.model,
+            self.others,
+            self.content,
+            &self.title,
+        ) {
             Ok(state) => self.state = Some(state),
             Err(e) => {
                 self.error = Some(e);
@@ -237,6 +253,12 @@ impl ApplicationHandler for App<'_> {
                     Key::Named(NamedKey::ArrowLeft) => state.orbit.yaw += 0.1,
                     Key::Named(NamedKey::ArrowRight) => state.orbit.yaw -= 0.1,
                     Key::Character("a" | "A") => state.auto = !state.auto,
+                    Key::Character("f" | "F") if matches!(state.drawn, Drawn::Scene(_)) => {
+                        state.flying = match state.flying {
+                            Some(_) => None,
+                            None => Some(Instant::now()),
+                        };
+                    }
                     Key::Character("w" | "W") => {
                         state.orbit.distance = (state.orbit.distance / 1.1).max(1.05);
                     }
@@ -268,6 +290,7 @@ impl<'m> State<'m> {
     fn new(
         event_loop: &ActiveEventLoop,
         model: &'m MtsModel,
+        others: &[&'m MtsModel],
         content: ViewerContent,
         title: &str,
     ) -> Result<State<'m>> {
@@ -340,7 +363,9 @@ impl<'m> State<'m> {
                     &device,
                     &queue,
                     &renderer_config,
-                    &[model],
+                    &std::iter::once(model)
+                        .chain(others.iter().copied())
+                        .collect::<Vec<_>>(),
                     count,
                     &mts_render::Appearance { checker },
                 )?;
@@ -374,6 +399,7 @@ impl<'m> State<'m> {
                 distance: 3.0,
             },
             ratio: 1.0,
+            flying: None,
             auto: matches!(content, ViewerContent::Scene { .. }),
             dragging: false,
             last_cursor: None,
@@ -403,7 +429,14 @@ impl<'m> State<'m> {
 
     fn frame(&mut self) -> Result<()> {
         let (w, h) = (self.config.width, self.config.height);
-        let camera = self.orbit.camera(w as f32 / h as f32);
+        let aspect = w as f32 / h as f32;
+        let camera = match (&self.drawn, self.flying) {
+            (Drawn::Scene(scene), Some(since)) => {
+                let t = (since.elapsed().as_secs_f32() / FLIGHT_SECONDS).fract();
+                scene.path_camera(t, aspect)
+            }
+            _ => self.orbit.camera(aspect),
+        };
         let t = Instant::now();
         let (triangles, indices) = match &mut self.drawn {
             Drawn::Model {
