@@ -23,12 +23,14 @@ pub mod camera;
 pub mod gpu;
 pub mod headless;
 pub mod scene;
+pub mod stats;
 pub mod strip_renderer;
 pub mod texture;
 
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{Difference, HeadlessTarget, Image};
+pub use stats::{DrawMeasurement, DrawQueries, PipelineCounts};
 pub use scene::{BvhUpdate, FrameStats, InstanceId, InstancedScene, ModelId, SceneMemory};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload, VERTEX_BYTES};
 pub use texture::Appearance;
