@@ -295,8 +295,17 @@ fn print_vertex_work(w: &VertexWork) {
     }
     println!(
         "{:>6} {:>14} {:>9} {:>9} {:>10} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
-        "level", "method", "triangles", "indices", "VS inv", "VS/tri", "clipper", "fifo16",
-        "batch96", "batch384", "lru32"
+        "level",
+        "method",
+        "triangles",
+        "indices",
+        "VS inv",
+        "VS/tri",
+        "clipper",
+        "fifo16",
+        "batch96",
+        "batch384",
+        "lru32"
     );
     let opt = |x: Option<u64>| x.map_or("—".into(), |x| x.to_string());
     for r in &w.rows {
@@ -323,7 +332,9 @@ fn print_vertex_work(w: &VertexWork) {
             w.clipper_mismatches,
             w.rows
                 .iter()
-                .filter(|r| r.clipper_invocations.is_some_and(|c| c != r.primitives_assembled as u64))
+                .filter(|r| r
+                    .clipper_invocations
+                    .is_some_and(|c| c != r.primitives_assembled as u64))
                 .count()
         );
     }

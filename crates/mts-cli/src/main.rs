@@ -607,8 +607,7 @@ fn list_acmr_json(mesh: &Mesh) -> (serde_json::Value, serde_json::Value) {
     use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
     let list = peers::meshopt::optimize_vertex_cache(&mesh.triangles, mesh.vertex_count());
     let flat: Vec<u32> = list.iter().flatten().copied().collect();
-    let per_triangle =
-        |model| vertex_work(&flat, Topology::List, model).per_triangle();
+    let per_triangle = |model| vertex_work(&flat, Topology::List, model).per_triangle();
     (
         json!(mts::strip::acmr::fifo_acmr(
             &list,

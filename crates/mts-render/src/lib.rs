@@ -14,6 +14,8 @@
 //!   JPEG, or a checker; mipmapped on the CPU, RGBA8 sRGB.
 //! - [`headless`]: render to a texture, read it back, write a PNG.
 //! - [`camera`]: a default camera that frames a bounding box.
+//! - [`stats`]: the adapter's own counts for a draw (vertex-shader,
+//!   clipper and fragment invocations; GPU time), where it offers them.
 //! - [`scene`]: many instances of one model, each with its own LoD and
 //!   coherence cache, frustum-culled.
 //!
@@ -30,8 +32,8 @@ pub mod texture;
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{Difference, HeadlessTarget, Image};
-pub use stats::{DrawMeasurement, DrawQueries, PipelineCounts};
 pub use scene::{BvhUpdate, FrameStats, InstanceId, InstancedScene, ModelId, SceneMemory};
+pub use stats::{DrawMeasurement, DrawQueries, PipelineCounts};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload, VERTEX_BYTES};
 pub use texture::Appearance;
 /// The wgpu this renderer is built with, so that embedders use the same

@@ -69,15 +69,13 @@ impl DrawQueries {
                     count: 1,
                 })
             });
-        let timestamps = features
-            .contains(wgpu::Features::TIMESTAMP_QUERY)
-            .then(|| {
-                device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("mts pass timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: 2,
-                })
-            });
+        let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
+            device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("mts pass timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            })
+        });
         let buffer = |usage, label| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -235,7 +233,9 @@ mod tests {
         let mut renderer = StripRenderer::new(d, q, &config, &positions, &triangles).unwrap();
         renderer.set_camera(q, &Camera::framing_points(&positions, target.aspect()));
         renderer.upload_list(d, q, &triangles).unwrap();
-        let m = queries.measure(d, q, &target, |pass| renderer.draw(pass)).unwrap();
+        let m = queries
+            .measure(d, q, &target, |pass| renderer.draw(pass))
+            .unwrap();
         let c = m.counts.unwrap();
         assert_eq!(c.clipper_invocations, 800);
         assert!(

@@ -38,9 +38,8 @@ impl StripStats {
         let triangles = strips.triangle_count();
         let indices_restart = strips.restart_index_count();
         let buffer = strips.to_restart_u32();
-        let per_triangle = |model| {
-            vertex_work(&buffer, Topology::StripRestart, model).per_triangle()
-        };
+        let per_triangle =
+            |model| vertex_work(&buffer, Topology::StripRestart, model).per_triangle();
         StripStats {
             triangles,
             strips: strips.run_count(),

@@ -209,11 +209,27 @@ mod tests {
         let list = [0, 1, 2, 2, 1, 3, 2, 3, 4, 4, 3, 5];
         // Batch 6: {0,1,2,3} then {2,3,4,5}: 8. One batch of 12: 6.
         let w = vertex_work(&list, Topology::List, CacheModel::Batch(6));
-        assert_eq!(w, VertexWork { invocations: 8, triangles: 4, indices: 12 });
-        assert_eq!(vertex_work(&list, Topology::List, CacheModel::Batch(12)).invocations, 6);
+        assert_eq!(
+            w,
+            VertexWork {
+                invocations: 8,
+                triangles: 4,
+                indices: 12
+            }
+        );
+        assert_eq!(
+            vertex_work(&list, Topology::List, CacheModel::Batch(12)).invocations,
+            6
+        );
         // FIFO 16 and LRU 32 hold all six vertices.
-        assert_eq!(vertex_work(&list, Topology::List, CacheModel::Fifo(16)).invocations, 6);
-        assert_eq!(vertex_work(&list, Topology::List, CacheModel::Lru(32)).invocations, 6);
+        assert_eq!(
+            vertex_work(&list, Topology::List, CacheModel::Fifo(16)).invocations,
+            6
+        );
+        assert_eq!(
+            vertex_work(&list, Topology::List, CacheModel::Lru(32)).invocations,
+            6
+        );
         assert_eq!(w.per_triangle(), 2.0);
     }
 
@@ -223,10 +239,20 @@ mod tests {
         // Batch 4 = [0 1 2 3] [R 4 5 6]: 4 + 3.
         let b = [0, 1, 2, 3, R, 4, 5, 6];
         let w = vertex_work(&b, Topology::StripRestart, CacheModel::Batch(4));
-        assert_eq!(w, VertexWork { invocations: 7, triangles: 3, indices: 8 });
+        assert_eq!(
+            w,
+            VertexWork {
+                invocations: 7,
+                triangles: 3,
+                indices: 8
+            }
+        );
         // Batch 3 = [0 1 2] [3 R 4] [5 6]: triangle (0,1,2) in batch 0,
         // (1,2,3) in batch 1 (1, 2 shaded again), (4,5,6) in batch 2.
-        assert_eq!(vertex_work(&b, Topology::StripRestart, CacheModel::Batch(3)).invocations, 9);
+        assert_eq!(
+            vertex_work(&b, Topology::StripRestart, CacheModel::Batch(3)).invocations,
+            9
+        );
     }
 
     #[test]
@@ -243,11 +269,21 @@ mod tests {
     fn degenerate_windows_are_shaded_but_not_counted() {
         // A swap: 0 1 0 2 has windows (0,1,0) degenerate, (1,0,2).
         let w = vertex_work(&[0, 1, 0, 2], Topology::StripRestart, CacheModel::Batch(96));
-        assert_eq!(w, VertexWork { invocations: 3, triangles: 1, indices: 4 });
+        assert_eq!(
+            w,
+            VertexWork {
+                invocations: 3,
+                triangles: 1,
+                indices: 4
+            }
+        );
     }
 
     fn stream() -> impl Strategy<Value = (Vec<u32>, bool)> {
-        (prop::collection::vec(prop_oneof![9 => 0u32..40, 1 => Just(R)], 0..300), any::<bool>())
+        (
+            prop::collection::vec(prop_oneof![9 => 0u32..40, 1 => Just(R)], 0..300),
+            any::<bool>(),
+        )
             .prop_map(|(mut v, list)| {
                 if list {
                     v.retain(|&i| i != R);
