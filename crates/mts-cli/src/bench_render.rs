@@ -11,6 +11,7 @@ use mts::{peers, Extractor};
 use mts_render::headless::HeadlessTarget;
 use mts_render::{Camera, Gpu, RendererConfig, StripRenderer};
 use serde::Serialize;
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 #[derive(Args)]
@@ -48,6 +49,7 @@ pub struct BenchRenderArgs {
 #[derive(Serialize)]
 struct RenderReport {
     scene: Option<Scene>,
+    vertex_work: VertexWork,
     input: String,
     adapter: String,
     backend: String,
@@ -73,6 +75,269 @@ struct RenderRow {
     triangles_per_second: f64,
     /// `None` for the list, which has no LoD step.
     lod_step_us: Option<f64>,
+}
+
+/// The adapter's own vertex work per method and level, beside the
+/// cache models' predictions for the buffer it drew.
+#[derive(Serialize)]
+struct VertexWork {
+    /// Whether the adapter offers pipeline statistics; when not, every
+    /// measured count is null.
+    pipeline_statistics: bool,
+    /// Whether it offers timestamps; when not, `gpu_ms` is null.
+    timestamps: bool,
+    /// Why measured fields are null, if they are.
+    note: Option<String>,
+    rows: Vec<VertexRow>,
+    /// Per cache model (`fifo16`, `batch96`, `batch384`, `lru32`): the
+    /// geometric mean over rows of measured/modelled invocations, and its
+    /// spread (mean |ln ratio|); null without statistics.
+    model_fit: BTreeMap<&'static str, Option<ModelFit>>,
+    /// The model with the smallest spread.
+    best_model: Option<&'static str>,
+    /// Rows whose clipper count differs from the triangles drawn.
+    clipper_mismatches: usize,
+}
+
+#[derive(Serialize, Clone, Copy)]
+struct ModelFit {
+    ratio_geomean: f64,
+    mean_abs_log_ratio: f64,
+}
+
+/// One method at one level: what it sent and what the adapter did.
+#[derive(Serialize)]
+struct VertexRow {
+    ratio: f64,
+    lod: usize,
+    /// Non-degenerate triangles drawn.
+    triangles: usize,
+    method: &'static str,
+    /// Indices in the drawn buffer (restart values or stitching included).
+    indices_sent: usize,
+    vertex_invocations: Option<u64>,
+    invocations_per_triangle: Option<f64>,
+    clipper_invocations: Option<u64>,
+    /// `clipper_invocations == triangles` (strips' degenerate windows may
+    /// reach the clipper on some drivers: then false, and counted).
+    clipper_matches_triangles: Option<bool>,
+    /// Primitives the buffer assembles to, degenerate windows (swaps,
+    /// stitching) included: what the clipper counts where it counts them.
+    primitives_assembled: usize,
+    fragment_invocations: Option<u64>,
+    /// Median GPU milliseconds of the pass over 5 passes.
+    gpu_ms: Option<f64>,
+    /// Modelled invocations of the drawn buffer per cache model.
+    modelled: BTreeMap<&'static str, u64>,
+    /// measured / modelled per cache model.
+    measured_over_modelled: BTreeMap<&'static str, Option<f64>>,
+}
+
+/// Shares of the vertex-work rows (the issue's 100/50/10/1%).
+const VERTEX_SHARES: [f64; 4] = [1.0, 0.5, 0.1, 0.01];
+
+/// Measures [`VertexWork`] of `model` on `gpu`: MTS strips (restart or
+/// stitched, as the backend draws), meshoptimizer's strips, the
+/// meshoptimizer-ordered list and the unordered list (the oracle's order)
+/// at each of [`VERTEX_SHARES`].
+fn measure_vertex_work(
+    gpu: &Gpu,
+    target: &HeadlessTarget,
+    config: &RendererConfig,
+    model: &mts::MtsModel,
+    camera: &Camera,
+) -> Result<VertexWork> {
+    use mts::strip::encode::stitch_restart_buffer;
+    use mts::strip::vertex_work::{vertex_work, Topology, REPORTED_MODELS};
+    use mts_render::{DrawQueries, StripMode};
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let queries = DrawQueries::new(d, q);
+    let mesh = model.mesh();
+    let mut renderer = StripRenderer::for_model(d, q, config, model)?;
+    renderer.set_camera(q, camera);
+    let mut ex = Extractor::new(model);
+    let mut rows = Vec::new();
+    for ratio in VERTEX_SHARES {
+        let lod = model.lod_for_ratio(ratio);
+        ex.set_lod(lod);
+        let oracle = model.collapses().triangles_at(&mesh, lod);
+        let n = model.positions().len();
+        let ordered = peers::meshopt::optimize_vertex_cache(&oracle, n);
+        let level = mts::Mesh {
+            positions: model.positions().to_vec(),
+            triangles: oracle.clone(),
+            properties: Default::default(),
+        };
+        let theirs = peers::meshopt::stripify(&level).to_restart_u32();
+        let ours = ex.buffer()[ex.active_range()].to_vec();
+        let flat = |t: &[[u32; 3]]| t.iter().flatten().copied().collect::<Vec<u32>>();
+        for (method, buffer, topology) in [
+            ("mts_strips", ours, Topology::StripRestart),
+            ("meshopt_strips", theirs, Topology::StripRestart),
+            ("meshopt_list", flat(&ordered), Topology::List),
+            ("list", flat(&oracle), Topology::List),
+        ] {
+            // What the GPU reads: the restart buffer, or its stitching.
+            let drawn = if topology == Topology::List {
+                renderer.upload_list(d, q, bytemuck_triangles(&buffer))?;
+                buffer
+            } else {
+                renderer.upload_strip_indices(d, q, &buffer)?;
+                match config.strip_mode {
+                    StripMode::Restart => buffer,
+                    StripMode::Stitched => {
+                        let mut out = Vec::new();
+                        stitch_restart_buffer(&buffer, &mut out);
+                        out
+                    }
+                }
+            };
+            let mut times = Vec::new();
+            let mut counts = None;
+            for _ in 0..5 {
+                let m = queries.measure(d, q, target, |pass| renderer.draw(pass))?;
+                counts = m.counts;
+                times.extend(m.gpu_ms);
+            }
+            times.sort_by(f64::total_cmp);
+            let triangles = model.triangle_count(lod);
+            let mut modelled = BTreeMap::new();
+            let mut ratios = BTreeMap::new();
+            for (name, cache) in REPORTED_MODELS {
+                let w = vertex_work(&drawn, topology, cache);
+                modelled.insert(name, w.invocations);
+                ratios.insert(
+                    name,
+                    counts.map(|c| c.vertex_invocations as f64 / w.invocations.max(1) as f64),
+                );
+            }
+            rows.push(VertexRow {
+                ratio,
+                lod,
+                triangles,
+                method,
+                indices_sent: drawn.len(),
+                vertex_invocations: counts.map(|c| c.vertex_invocations),
+                invocations_per_triangle: counts
+                    .map(|c| c.vertex_invocations as f64 / triangles.max(1) as f64),
+                clipper_invocations: counts.map(|c| c.clipper_invocations),
+                primitives_assembled: assembled(&drawn, topology),
+                clipper_matches_triangles: counts
+                    .map(|c| c.clipper_invocations == triangles as u64),
+                fragment_invocations: counts.map(|c| c.fragment_invocations),
+                gpu_ms: times.get(times.len() / 2).copied(),
+                modelled,
+                measured_over_modelled: ratios,
+            });
+        }
+    }
+    let mut model_fit = BTreeMap::new();
+    for (name, _) in REPORTED_MODELS {
+        let logs: Option<Vec<f64>> = rows
+            .iter()
+            .map(|r| r.measured_over_modelled[name].map(f64::ln))
+            .collect();
+        let fit = logs.filter(|l| !l.is_empty()).map(|l| ModelFit {
+            ratio_geomean: (l.iter().sum::<f64>() / l.len() as f64).exp(),
+            mean_abs_log_ratio: l.iter().map(|x| x.abs()).sum::<f64>() / l.len() as f64,
+        });
+        model_fit.insert(name, fit);
+    }
+    let best_model = model_fit
+        .iter()
+        .filter_map(|(n, f)| f.map(|f| (*n, f.mean_abs_log_ratio)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(n, _)| n);
+    let mut missing = Vec::new();
+    if !queries.has_statistics() {
+        missing.push("pipeline statistics");
+    }
+    if !queries.has_timestamps() {
+        missing.push("timestamps");
+    }
+    Ok(VertexWork {
+        pipeline_statistics: queries.has_statistics(),
+        timestamps: queries.has_timestamps(),
+        note: (!missing.is_empty())
+            .then(|| format!("the adapter does not offer {}", missing.join(" or "))),
+        clipper_mismatches: rows
+            .iter()
+            .filter(|r| r.clipper_matches_triangles == Some(false))
+            .count(),
+        rows,
+        model_fit,
+        best_model,
+    })
+}
+
+/// Windows of three indices `buffer` assembles to (no restart inside).
+fn assembled(buffer: &[u32], topology: mts::strip::vertex_work::Topology) -> usize {
+    use mts::strip::encode::RESTART_U32;
+    if topology == mts::strip::vertex_work::Topology::List {
+        return buffer.len() / 3;
+    }
+    buffer
+        .windows(3)
+        .filter(|w| !w.contains(&RESTART_U32))
+        .count()
+}
+
+/// A flat list as triangles (its length is a multiple of 3).
+fn bytemuck_triangles(flat: &[u32]) -> &[[u32; 3]] {
+    bytemuck::cast_slice(flat)
+}
+
+/// The vertex-work rows as text.
+fn print_vertex_work(w: &VertexWork) {
+    println!("vertex work (adapter counts; modelled invocations per cache model):");
+    if let Some(note) = &w.note {
+        println!("  {note}");
+    }
+    println!(
+        "{:>6} {:>14} {:>9} {:>9} {:>10} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
+        "level",
+        "method",
+        "triangles",
+        "indices",
+        "VS inv",
+        "VS/tri",
+        "clipper",
+        "fifo16",
+        "batch96",
+        "batch384",
+        "lru32"
+    );
+    let opt = |x: Option<u64>| x.map_or("—".into(), |x| x.to_string());
+    for r in &w.rows {
+        println!(
+            "{:>5.0}% {:>14} {:>9} {:>9} {:>10} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
+            100.0 * r.ratio,
+            r.method,
+            r.triangles,
+            r.indices_sent,
+            opt(r.vertex_invocations),
+            r.invocations_per_triangle
+                .map_or("—".into(), |x| format!("{x:.3}")),
+            opt(r.clipper_invocations),
+            r.modelled["fifo16"],
+            r.modelled["batch96"],
+            r.modelled["batch384"],
+            r.modelled["lru32"],
+        );
+    }
+    if let Some(best) = w.best_model {
+        println!(
+            "best-fitting model: {best}; clipper count differs from triangles in {} rows \
+             ({} from the primitives assembled, degenerate windows included)",
+            w.clipper_mismatches,
+            w.rows
+                .iter()
+                .filter(|r| r
+                    .clipper_invocations
+                    .is_some_and(|c| c != r.primitives_assembled as u64))
+                .count()
+        );
+    }
 }
 
 /// Median milliseconds of `frames` frames of `renderer` into `target`.
@@ -183,6 +448,10 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
             });
         }
     }
+    let vertex = measure_vertex_work(&gpu, &target, &config, &model, &camera)?;
+    if !args.json {
+        print_vertex_work(&vertex);
+    }
     let scene = if args.scene > 0 {
         let others = args
             .scene_with
@@ -203,6 +472,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
     if args.json {
         let out = RenderReport {
             scene,
+            vertex_work: vertex,
             input: name,
             adapter: report.name,
             backend: format!("{:?}", report.backend),

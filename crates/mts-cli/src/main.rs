@@ -590,8 +590,32 @@ fn median_ms<T>(repeat: usize, mut f: impl FnMut() -> T) -> (T, f64) {
 }
 
 /// `mts strips --json`'s figures of one stripifier: the bench's row.
+/// The bench's strip row plus the other cache models' invocations per
+/// triangle (kept out of the typed bench results).
 fn stats_json(s: &StripStats) -> serde_json::Value {
-    json!(results::StripRow::from(s))
+    let mut v = json!(results::StripRow::from(s));
+    v["acmr_batch96"] = json!(s.acmr_batch96);
+    v["acmr_batch384"] = json!(s.acmr_batch384);
+    v["acmr_lru32"] = json!(s.acmr_lru32);
+    v
+}
+
+/// `list_acmr` (FIFO 16) and `list_acmr_batch96` of the
+/// meshoptimizer-ordered triangle list of `mesh`: the list strips compete
+/// with.
+fn list_acmr_json(mesh: &Mesh) -> (serde_json::Value, serde_json::Value) {
+    use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
+    let list = peers::meshopt::optimize_vertex_cache(&mesh.triangles, mesh.vertex_count());
+    let flat: Vec<u32> = list.iter().flatten().copied().collect();
+    let per_triangle = |model| vertex_work(&flat, Topology::List, model).per_triangle();
+    (
+        json!(mts::strip::acmr::fifo_acmr(
+            &list,
+            mesh.vertex_count(),
+            mts::strip::acmr::CACHE_SIZE
+        )),
+        json!(per_triangle(CacheModel::Batch(96))),
+    )
 }
 
 fn strips(args: &StripsArgs) -> Result<()> {
@@ -625,6 +649,12 @@ fn strips(args: &StripsArgs) -> Result<()> {
         if let Some(why) = &skipped {
             v["meshopt_skipped"] = json!(why);
         }
+        let (list_acmr, list_batch96) = match &skipped {
+            None => list_acmr_json(&mesh),
+            Some(_) => (serde_json::Value::Null, serde_json::Value::Null),
+        };
+        v["list_acmr"] = list_acmr;
+        v["list_acmr_batch96"] = list_batch96;
         v["mesh"] = json!(name);
         v["vertices"] = json!(mesh.vertex_count());
         println!("{}", serde_json::to_string_pretty(&v)?);

@@ -116,7 +116,8 @@ pub struct Gpu {
 impl Gpu {
     /// Opens the adapter that `WGPU_ADAPTER_NAME` names, or wgpu's default
     /// one (any backend `WGPU_BACKEND` allows; no surface), and a device with
-    /// the downlevel default limits raised to the adapter's texture sizes.
+    /// the downlevel default limits raised to the adapter's texture sizes,
+    /// and the pipeline-statistics and timestamp queries where offered.
     ///
     /// # Errors
     /// [`Error::NoAdapter`] when no adapter exists (no GPU and no software
@@ -149,6 +150,10 @@ impl Gpu {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("mts headless device"),
             required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            // Only what the adapter has: `crate::stats` reads a missing
+            // query as "not offered", never as a number.
+            required_features: adapter.features()
+                & (wgpu::Features::PIPELINE_STATISTICS_QUERY | wgpu::Features::TIMESTAMP_QUERY),
             ..wgpu::DeviceDescriptor::default()
         }))
         .map_err(|e| Error::Gpu(format!("cannot create a device: {e}")))?;

@@ -332,11 +332,23 @@ impl HeadlessTarget {
         encoder: &mut wgpu::CommandEncoder,
         draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
     ) {
-        let mut pass = begin_cleared_pass(
+        self.encode_timed_pass(encoder, None, draw);
+    }
+
+    /// Encodes the cleared pass with `timestamps` written at its start and
+    /// end (for [`crate::stats`]).
+    pub(crate) fn encode_timed_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+        draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) {
+        let mut pass = begin_pass(
             encoder,
             "mts headless pass",
             &self.color_view,
             &self.depth_view,
+            timestamps,
         );
         draw(&mut pass);
     }
@@ -364,6 +376,16 @@ pub fn begin_cleared_pass<'e>(
     color: &wgpu::TextureView,
     depth: &wgpu::TextureView,
 ) -> wgpu::RenderPass<'e> {
+    begin_pass(encoder, label, color, depth, None)
+}
+
+fn begin_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    color: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+) -> wgpu::RenderPass<'e> {
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -383,7 +405,7 @@ pub fn begin_cleared_pass<'e>(
             }),
             stencil_ops: None,
         }),
-        timestamp_writes: None,
+        timestamp_writes,
         occlusion_query_set: None,
         multiview_mask: None,
     })

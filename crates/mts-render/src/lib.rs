@@ -14,6 +14,8 @@
 //!   JPEG, or a checker; mipmapped on the CPU, RGBA8 sRGB.
 //! - [`headless`]: render to a texture, read it back, write a PNG.
 //! - [`camera`]: a default camera that frames a bounding box.
+//! - [`stats`]: the adapter's own counts for a draw (vertex-shader,
+//!   clipper and fragment invocations; GPU time), where it offers them.
 //! - [`scene`]: many instances of one model, each with its own LoD and
 //!   coherence cache, frustum-culled.
 //!
@@ -23,6 +25,7 @@ pub mod camera;
 pub mod gpu;
 pub mod headless;
 pub mod scene;
+pub mod stats;
 pub mod strip_renderer;
 pub mod texture;
 
@@ -30,6 +33,7 @@ pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{Difference, HeadlessTarget, Image};
 pub use scene::{BvhUpdate, FrameStats, InstanceId, InstancedScene, ModelId, SceneMemory};
+pub use stats::{DrawMeasurement, DrawQueries, PipelineCounts};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload, VERTEX_BYTES};
 pub use texture::Appearance;
 /// The wgpu this renderer is built with, so that embedders use the same

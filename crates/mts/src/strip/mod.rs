@@ -13,6 +13,7 @@ pub mod acmr;
 pub mod encode;
 pub mod stats;
 pub mod stripify;
+pub mod vertex_work;
 
 pub use stripify::{stripify, StripifyOptions};
 

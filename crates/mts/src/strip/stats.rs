@@ -1,5 +1,6 @@
 //! Figures of merit for a set of strips.
 
+use super::vertex_work::{vertex_work, CacheModel, Topology};
 use super::Strips;
 
 /// What `mts strips` reports for one stripifier.
@@ -18,6 +19,14 @@ pub struct StripStats {
     /// Average cache miss ratio (vertex transforms per triangle) of the
     /// strips' triangle order in a 16-entry FIFO cache.
     pub acmr: f64,
+    /// Modelled vertex-shader invocations per triangle of the restart
+    /// buffer in batches of 96 indices (NVIDIA, after Kerbl et al. 2018;
+    /// restart values count toward a batch: see [`super::vertex_work`]).
+    pub acmr_batch96: f64,
+    /// The same in batches of 384 indices (AMD).
+    pub acmr_batch384: f64,
+    /// The same through a 32-entry LRU cache.
+    pub acmr_lru32: f64,
     /// Milliseconds the stripifier took.
     pub ms: f64,
 }
@@ -28,6 +37,9 @@ impl StripStats {
     pub fn new(strips: &Strips, ms: f64) -> StripStats {
         let triangles = strips.triangle_count();
         let indices_restart = strips.restart_index_count();
+        let buffer = strips.to_restart_u32();
+        let per_triangle =
+            |model| vertex_work(&buffer, Topology::StripRestart, model).per_triangle();
         StripStats {
             triangles,
             strips: strips.run_count(),
@@ -39,6 +51,9 @@ impl StripStats {
                 strips.vertex_count() as usize,
                 super::acmr::CACHE_SIZE,
             ),
+            acmr_batch96: per_triangle(CacheModel::Batch(96)),
+            acmr_batch384: per_triangle(CacheModel::Batch(384)),
+            acmr_lru32: per_triangle(CacheModel::Lru(32)),
             ms,
         }
     }
