@@ -453,16 +453,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
         print_vertex_work(&vertex);
     }
     let scene = if args.scene > 0 {
-        let others = args
-            .scene_with
-            .iter()
-            .map(|p| {
-                let (mesh, _) = mts::mesh::io::load(p, Default::default())?;
-                let (m, _, _) =
-                    mts::model::build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});
-                Ok((p.display().to_string(), m))
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let others = crate::demo_scene::load_models(&args.scene_with)?;
         let mut models = vec![(name.clone(), &model)];
         models.extend(others.iter().map(|(n, m)| (n.clone(), m)));
         Some(bench_scene(&gpu, &target, &config, &models, args)?)
