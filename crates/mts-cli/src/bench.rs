@@ -147,10 +147,17 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
     }
     scene_names.truncate(SCENE_MODELS);
     let mut scene_models = Vec::new();
+    // The vertex-work model: the scene's first (the bunny when measured).
+    let vertex_name = scene_names.first().map(|n| (*n).clone());
+    let mut vertex_work = None;
     for (name, mesh) in &inputs {
         progress(name);
         let (row, model) = measure_model(name, mesh, requests, repeat, &renderer, shares, frames)?;
         models.push(row);
+        if let (Ok(r), true) = (&renderer, vertex_name.as_ref() == Some(name)) {
+            progress(&format!("vertex work of {name}"));
+            vertex_work = Some(r.measure_vertex_work(name, &model)?);
+        }
         if scene_names.contains(&name) {
             scene_models.push((name.clone(), model));
         }
@@ -182,8 +189,74 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
         scale,
         fast_simplification,
         scenes,
+        vertex_work,
         properties,
     })
+}
+
+/// The report's measured vertex work: the adapter's counts beside the
+/// cache models' predictions for the buffers it drew.
+fn vertex_table(s: &mut String, w: Option<&crate::results::VertexWork>) {
+    let Some(w) = w else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "\n### Vertex work measured by the adapter: {}\n",
+        w.model
+    );
+    let _ = writeln!(s, "Pipeline-statistics queries on Figure 6's adapter (`mts bench render`): vertex-shader invocations per triangle drawn, beside the invocations the cache models predict for the same index buffer (FIFO of 16, batches of 96 and 384 indices, LRU of 32; per triangle), clipper primitives against the triangles drawn (degenerate strip windows included where the clipper counts them) and the pass's GPU time (timestamps, median of 5). Methods: MTS strips as the backend draws them, meshoptimizer's strips, the meshoptimizer-ordered list and the list in the oracle's order.\n");
+    if let Some(note) = &w.note {
+        let _ = writeln!(s, "Not measured: {note}.\n");
+    }
+    let _ = writeln!(s, "| share | method | triangles | indices | measured / triangle | FIFO16 | batch96 | batch384 | LRU32 | clipper (assembled) | GPU ms |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let opt =
+        |x: Option<f64>, digits: usize| x.map_or("—".to_string(), |x| format!("{x:.digits$}"));
+    for r in &w.rows {
+        let per = |name: &str| {
+            let m = r.modelled.get(name).copied().unwrap_or(0);
+            format!("{:.3}", m as f64 / r.triangles.max(1) as f64)
+        };
+        let _ = writeln!(
+            s,
+            "| {:.0}% | {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) | {} |",
+            r.ratio * 100.0,
+            r.method,
+            r.triangles,
+            r.indices_sent,
+            opt(r.invocations_per_triangle, 3),
+            per("fifo16"),
+            per("batch96"),
+            per("batch384"),
+            per("lru32"),
+            r.clipper_invocations
+                .map_or("—".to_string(), |c| c.to_string()),
+            r.primitives_assembled,
+            opt(r.gpu_ms, 2),
+        );
+    }
+    let fits: Vec<String> = w
+        .model_fit
+        .iter()
+        .filter_map(|(n, f)| {
+            f.map(|f| {
+                format!(
+                    "{n} {:.3} (spread {:.3})",
+                    f.ratio_geomean, f.mean_abs_log_ratio
+                )
+            })
+        })
+        .collect();
+    if !fits.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nMeasured / modelled invocations, geometric mean over the rows (spread: mean |ln ratio|): {}; the best fit here: {}. Rows whose clipper count differs from the triangles drawn: {}.",
+            fits.join(", "),
+            w.best_model.as_deref().unwrap_or("—"),
+            w.clipper_mismatches
+        );
+    }
 }
 
 /// The report's section on the scene.
@@ -1069,6 +1142,7 @@ pub fn report(results: &Results) -> String {
             );
         }
     }
+    vertex_table(&mut s, results.vertex_work.as_ref());
     let _ = writeln!(s, "\nPrinted reference, not measured here: the MTS paper's Table 3 for the bunny (vertices sent): Skip Strips / MTS —");
     for (t, skip, ours) in PAPER_TABLE_3 {
         let _ = write!(s, " {t} triangles: {skip} / {ours};");

@@ -4,7 +4,7 @@
 
 use super::render::Size;
 use super::MeshSource;
-use crate::results::Scene;
+use crate::results::{ModelFit, Scene, VertexRow, VertexWork};
 use anyhow::Result;
 use clap::Args;
 use mts::{peers, Extractor};
@@ -77,62 +77,6 @@ struct RenderRow {
     lod_step_us: Option<f64>,
 }
 
-/// The adapter's own vertex work per method and level, beside the
-/// cache models' predictions for the buffer it drew.
-#[derive(Serialize)]
-struct VertexWork {
-    /// Whether the adapter offers pipeline statistics; when not, every
-    /// measured count is null.
-    pipeline_statistics: bool,
-    /// Whether it offers timestamps; when not, `gpu_ms` is null.
-    timestamps: bool,
-    /// Why measured fields are null, if they are.
-    note: Option<String>,
-    rows: Vec<VertexRow>,
-    /// Per cache model (`fifo16`, `batch96`, `batch384`, `lru32`): the
-    /// geometric mean over rows of measured/modelled invocations, and its
-    /// spread (mean |ln ratio|); null without statistics.
-    model_fit: BTreeMap<&'static str, Option<ModelFit>>,
-    /// The model with the smallest spread.
-    best_model: Option<&'static str>,
-    /// Rows whose clipper count differs from the triangles drawn.
-    clipper_mismatches: usize,
-}
-
-#[derive(Serialize, Clone, Copy)]
-struct ModelFit {
-    ratio_geomean: f64,
-    mean_abs_log_ratio: f64,
-}
-
-/// One method at one level: what it sent and what the adapter did.
-#[derive(Serialize)]
-struct VertexRow {
-    ratio: f64,
-    lod: usize,
-    /// Non-degenerate triangles drawn.
-    triangles: usize,
-    method: &'static str,
-    /// Indices in the drawn buffer (restart values or stitching included).
-    indices_sent: usize,
-    vertex_invocations: Option<u64>,
-    invocations_per_triangle: Option<f64>,
-    clipper_invocations: Option<u64>,
-    /// `clipper_invocations == triangles` (strips' degenerate windows may
-    /// reach the clipper on some drivers: then false, and counted).
-    clipper_matches_triangles: Option<bool>,
-    /// Primitives the buffer assembles to, degenerate windows (swaps,
-    /// stitching) included: what the clipper counts where it counts them.
-    primitives_assembled: usize,
-    fragment_invocations: Option<u64>,
-    /// Median GPU milliseconds of the pass over 5 passes.
-    gpu_ms: Option<f64>,
-    /// Modelled invocations of the drawn buffer per cache model.
-    modelled: BTreeMap<&'static str, u64>,
-    /// measured / modelled per cache model.
-    measured_over_modelled: BTreeMap<&'static str, Option<f64>>,
-}
-
 /// Shares of the vertex-work rows (the issue's 100/50/10/1%).
 const VERTEX_SHARES: [f64; 4] = [1.0, 0.5, 0.1, 0.01];
 
@@ -140,10 +84,11 @@ const VERTEX_SHARES: [f64; 4] = [1.0, 0.5, 0.1, 0.01];
 /// stitched, as the backend draws), meshoptimizer's strips, the
 /// meshoptimizer-ordered list and the unordered list (the oracle's order)
 /// at each of [`VERTEX_SHARES`].
-fn measure_vertex_work(
+pub fn measure_vertex_work(
     gpu: &Gpu,
     target: &HeadlessTarget,
     config: &RendererConfig,
+    model_name: &str,
     model: &mts::MtsModel,
     camera: &Camera,
 ) -> Result<VertexWork> {
@@ -205,23 +150,23 @@ fn measure_vertex_work(
             let mut ratios = BTreeMap::new();
             for (name, cache) in REPORTED_MODELS {
                 let w = vertex_work(&drawn, topology, cache);
-                modelled.insert(name, w.invocations);
+                modelled.insert(name.to_string(), w.invocations);
                 ratios.insert(
-                    name,
+                    name.to_string(),
                     counts.map(|c| c.vertex_invocations as f64 / w.invocations.max(1) as f64),
                 );
             }
             rows.push(VertexRow {
                 ratio,
-                lod,
-                triangles,
-                method,
-                indices_sent: drawn.len(),
+                lod: lod as u64,
+                triangles: triangles as u64,
+                method: method.to_string(),
+                indices_sent: drawn.len() as u64,
                 vertex_invocations: counts.map(|c| c.vertex_invocations),
                 invocations_per_triangle: counts
                     .map(|c| c.vertex_invocations as f64 / triangles.max(1) as f64),
                 clipper_invocations: counts.map(|c| c.clipper_invocations),
-                primitives_assembled: assembled(&drawn, topology),
+                primitives_assembled: assembled(&drawn, topology) as u64,
                 clipper_matches_triangles: counts
                     .map(|c| c.clipper_invocations == triangles as u64),
                 fragment_invocations: counts.map(|c| c.fragment_invocations),
@@ -241,11 +186,11 @@ fn measure_vertex_work(
             ratio_geomean: (l.iter().sum::<f64>() / l.len() as f64).exp(),
             mean_abs_log_ratio: l.iter().map(|x| x.abs()).sum::<f64>() / l.len() as f64,
         });
-        model_fit.insert(name, fit);
+        model_fit.insert(name.to_string(), fit);
     }
     let best_model = model_fit
         .iter()
-        .filter_map(|(n, f)| f.map(|f| (*n, f.mean_abs_log_ratio)))
+        .filter_map(|(n, f)| f.map(|f| (n.clone(), f.mean_abs_log_ratio)))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(n, _)| n);
     let mut missing = Vec::new();
@@ -256,6 +201,7 @@ fn measure_vertex_work(
         missing.push("timestamps");
     }
     Ok(VertexWork {
+        model: model_name.to_string(),
         pipeline_statistics: queries.has_statistics(),
         timestamps: queries.has_timestamps(),
         note: (!missing.is_empty())
@@ -263,7 +209,7 @@ fn measure_vertex_work(
         clipper_mismatches: rows
             .iter()
             .filter(|r| r.clipper_matches_triangles == Some(false))
-            .count(),
+            .count() as u64,
         rows,
         model_fit,
         best_model,
@@ -325,7 +271,7 @@ fn print_vertex_work(w: &VertexWork) {
             r.modelled["lru32"],
         );
     }
-    if let Some(best) = w.best_model {
+    if let Some(best) = &w.best_model {
         println!(
             "best-fitting model: {best}; clipper count differs from triangles in {} rows \
              ({} from the primitives assembled, degenerate windows included)",
@@ -448,7 +394,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
             });
         }
     }
-    let vertex = measure_vertex_work(&gpu, &target, &config, &model, &camera)?;
+    let vertex = measure_vertex_work(&gpu, &target, &config, &name, &model, &camera)?;
     if !args.json {
         print_vertex_work(&vertex);
     }

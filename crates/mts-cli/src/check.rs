@@ -200,6 +200,35 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
         }
     }
     if r.machine.adapter.is_some() {
+        // Vertex work: the four methods at four shares; where statistics
+        // are offered, every row measured, the clipper counting either the
+        // triangles drawn or the primitives assembled.
+        match &r.vertex_work {
+            Some(w) => {
+                need(
+                    w.rows.len() == 16,
+                    format!("vertex work: {} rows, not 16", w.rows.len()),
+                );
+                for row in &w.rows {
+                    let at = format!("vertex work {} at {}", row.method, row.ratio);
+                    need(
+                        row.vertex_invocations.is_some() == w.pipeline_statistics
+                            && row.modelled.len() == 4,
+                        format!("{at}: measured or modelled counts missing"),
+                    );
+                    if let Some(c) = row.clipper_invocations {
+                        need(
+                            c == row.triangles || c == row.primitives_assembled,
+                            format!(
+                                "{at}: clipper {c}, neither {} triangles nor {} assembled",
+                                row.triangles, row.primitives_assembled
+                            ),
+                        );
+                    }
+                }
+            }
+            None => need(false, "an adapter ran but no vertex work".into()),
+        }
         let counts: &[u64] = if quick {
             &[250]
         } else {

@@ -256,6 +256,27 @@ impl Renderer {
         })
     }
 
+    /// The adapter's vertex work on `model` (see `mts bench render`),
+    /// framed as Figure 6 frames it.
+    ///
+    /// # Errors
+    /// As [`super::bench_render::measure_vertex_work`].
+    pub fn measure_vertex_work(
+        &self,
+        name: &str,
+        model: &MtsModel,
+    ) -> Result<crate::results::VertexWork> {
+        let camera = Camera::framing_points(model.positions(), self.target.aspect());
+        super::bench_render::measure_vertex_work(
+            &self.gpu,
+            &self.target,
+            &self.config,
+            name,
+            model,
+            &camera,
+        )
+    }
+
     /// Scene rows (see `mts bench render --scene`) of `models`.
     ///
     /// # Errors

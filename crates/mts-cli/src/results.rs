@@ -25,6 +25,9 @@ pub struct Results {
     pub fast_simplification: Option<FastSimplificationRun>,
     /// `null` without an adapter.
     pub scenes: Vec<Scene>,
+    /// Measured vertex work of one model (the bunny when measured) on
+    /// machine.adapter; null without one.
+    pub vertex_work: Option<VertexWork>,
     /// Vertex properties against meshoptimizer's `simplifyWithAttributes`:
     /// one row per model with properties and share.
     pub properties: Vec<PropertyRow>,
@@ -346,6 +349,68 @@ pub struct Scene {
     /// The same, counting only pixels covered by instances in one image
     /// and not the other (silhouettes that moved).
     pub coverage_differing_pixel_share: Option<f64>,
+}
+
+/// The adapter's own vertex work per method and level, beside the cache
+/// models' predictions for the buffer it drew (`mts bench render`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VertexWork {
+    /// The model measured.
+    pub model: String,
+    /// Whether the adapter offers pipeline statistics; when not, every
+    /// measured count is null.
+    pub pipeline_statistics: bool,
+    /// Whether it offers timestamps; when not, `gpu_ms` is null.
+    pub timestamps: bool,
+    /// Why measured fields are null, if they are.
+    pub note: Option<String>,
+    pub rows: Vec<VertexRow>,
+    /// Per cache model (`fifo16`, `batch96`, `batch384`, `lru32`): the
+    /// geometric mean over rows of measured/modelled invocations, and its
+    /// spread (mean |ln ratio|); null without statistics.
+    pub model_fit: BTreeMap<String, Option<ModelFit>>,
+    /// The model with the smallest spread.
+    pub best_model: Option<String>,
+    /// Rows whose clipper count differs from the triangles drawn.
+    pub clipper_mismatches: u64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFit {
+    pub ratio_geomean: f64,
+    pub mean_abs_log_ratio: f64,
+}
+
+/// One method at one level: what it sent and what the adapter did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VertexRow {
+    pub ratio: f64,
+    pub lod: u64,
+    /// Non-degenerate triangles drawn.
+    pub triangles: u64,
+    /// `mts_strips`, `meshopt_strips`, `meshopt_list`, `list`.
+    pub method: String,
+    /// Indices in the drawn buffer (restart values or stitching included).
+    pub indices_sent: u64,
+    pub vertex_invocations: Option<u64>,
+    pub invocations_per_triangle: Option<f64>,
+    pub clipper_invocations: Option<u64>,
+    /// `clipper_invocations == triangles` (strips' degenerate windows may
+    /// reach the clipper on some drivers: then false, and counted).
+    pub clipper_matches_triangles: Option<bool>,
+    /// Primitives the buffer assembles to, degenerate windows (swaps,
+    /// stitching) included: what the clipper counts where it counts them.
+    pub primitives_assembled: u64,
+    pub fragment_invocations: Option<u64>,
+    /// Median GPU milliseconds of the pass over 5 passes.
+    pub gpu_ms: Option<f64>,
+    /// Modelled invocations of the drawn buffer per cache model.
+    pub modelled: BTreeMap<String, u64>,
+    /// measured / modelled per cache model.
+    pub measured_over_modelled: BTreeMap<String, Option<f64>>,
 }
 
 impl Results {
