@@ -280,7 +280,7 @@ fn print_vertex_work(w: &VertexWork) {
                 .iter()
                 .filter(|r| r
                     .clipper_invocations
-                    .is_some_and(|c| c != r.primitives_assembled as u64))
+                    .is_some_and(|c| c != r.primitives_assembled))
                 .count()
         );
     }
