@@ -205,7 +205,7 @@ fn vertex_table(s: &mut String, w: Option<&crate::results::VertexWork>) {
         "\n### Vertex work measured by the adapter: {}\n",
         w.model
     );
-    let _ = writeln!(s, "Pipeline-statistics queries on Figure 6's adapter (`mts bench render`): vertex-shader invocations per triangle drawn, beside the invocations the cache models predict for the same index buffer (FIFO of 16, batches of 96 and 384 indices, LRU of 32; per triangle), clipper primitives against the triangles drawn (degenerate strip windows included where the clipper counts them) and the pass's GPU time (timestamps, median of 5). Methods: MTS strips as the backend draws them, meshoptimizer's strips, the meshoptimizer-ordered list and the list in the oracle's order.\n");
+    let _ = writeln!(s, "Pipeline-statistics queries on Figure 6's adapter (`mts bench render`): vertex-shader invocations per triangle drawn, beside the invocations the cache models predict for the same index buffer (FIFO of 16, batches of 96 and 384 indices, LRU of 32; per triangle), clipper primitives against the triangles drawn (degenerate strip windows included where the clipper counts them) and the pass's GPU time (timestamps, median of 5). Methods: MTS strips as the backend draws them, meshoptimizer's strips, the meshoptimizer-ordered list, the list in the oracle's order, and the baselines' lists at their finest LoD within the same triangles.\n");
     if let Some(note) = &w.note {
         let _ = writeln!(s, "Not measured: {note}.\n");
     }

@@ -83,7 +83,10 @@ const VERTEX_SHARES: [f64; 4] = [1.0, 0.5, 0.1, 0.01];
 /// Measures [`VertexWork`] of `model` on `gpu`: MTS strips (restart or
 /// stitched, as the backend draws), meshoptimizer's strips, the
 /// meshoptimizer-ordered list and the unordered list (the oracle's order)
-/// at each of [`VERTEX_SHARES`].
+/// at each of [`VERTEX_SHARES`], and the baselines' lists (`pm_list`,
+/// `multilevel_list`, `cluster_list`, `discrete_list`; discrete where
+/// meshoptimizer takes the mesh) at their finest LoD within the same
+/// triangles.
 pub fn measure_vertex_work(
     gpu: &Gpu,
     target: &HeadlessTarget,
@@ -93,7 +96,7 @@ pub fn measure_vertex_work(
     camera: &Camera,
 ) -> Result<VertexWork> {
     use mts::strip::encode::stitch_restart_buffer;
-    use mts::strip::vertex_work::{vertex_work, Topology, REPORTED_MODELS};
+    use mts::strip::vertex_work::{Topology, REPORTED_MODELS};
     use mts_render::{DrawQueries, StripMode};
     let (d, q) = (&gpu.device, &gpu.queue);
     let queries = DrawQueries::new(d, q);
@@ -137,45 +140,44 @@ pub fn measure_vertex_work(
                     }
                 }
             };
-            let mut times = Vec::new();
-            let mut counts = None;
-            for _ in 0..5 {
-                let m = queries.measure(d, q, target, |pass| renderer.draw(pass))?;
-                counts = m.counts;
-                times.extend(m.gpu_ms);
-            }
-            times.sort_by(f64::total_cmp);
             let triangles = model.triangle_count(lod);
-            let mut modelled = BTreeMap::new();
-            let mut ratios = BTreeMap::new();
-            for (name, cache) in REPORTED_MODELS {
-                let w = vertex_work(&drawn, topology, cache);
-                modelled.insert(name.to_string(), w.invocations);
-                ratios.insert(
-                    name.to_string(),
-                    counts.map(|c| c.vertex_invocations as f64 / w.invocations.max(1) as f64),
-                );
-            }
-            rows.push(VertexRow {
-                ratio,
-                lod: lod as u64,
-                triangles: triangles as u64,
-                method: method.to_string(),
-                indices_sent: drawn.len() as u64,
-                vertex_invocations: counts.map(|c| c.vertex_invocations),
-                invocations_per_triangle: counts
-                    .map(|c| c.vertex_invocations as f64 / triangles.max(1) as f64),
-                clipper_invocations: counts.map(|c| c.clipper_invocations),
-                primitives_assembled: assembled(&drawn, topology) as u64,
-                clipper_matches_triangles: counts
-                    .map(|c| c.clipper_invocations == triangles as u64),
-                fragment_invocations: counts.map(|c| c.fragment_invocations),
-                gpu_ms: times.get(times.len() / 2).copied(),
-                modelled,
-                measured_over_modelled: ratios,
-            });
+            rows.push(vertex_row(
+                &queries, d, q, target, &renderer, method, ratio, lod, triangles, &drawn, topology,
+            )?);
         }
     }
+    // The baselines' lists (their own vertex numbering), each at its
+    // finest LoD within the MTS level's triangles.
+    for method in [
+        super::Method::Pm,
+        super::Method::Multilevel,
+        super::Method::Cluster,
+        super::Method::Discrete,
+    ] {
+        if method == super::Method::Discrete && peers::meshopt::refusal(&mesh).is_some() {
+            continue;
+        }
+        let mut source = super::make_source(method, model, &mesh)?;
+        let mut renderer = StripRenderer::for_source(d, q, config, source.as_mut())?;
+        renderer.set_camera(q, camera);
+        for ratio in VERTEX_SHARES {
+            let budget = model.triangle_count(model.lod_for_ratio(ratio));
+            let lod = source.set_lod(mts::lod::lod_for_triangles(&*source, budget));
+            renderer.upload_source(d, q, &*source)?;
+            let topology = match source.topology() {
+                mts::Topology::TriangleList => Topology::List,
+                mts::Topology::StripRestart => Topology::StripRestart,
+            };
+            let name = format!("{}_list", source.name());
+            let triangles = source.triangle_count(lod);
+            let drawn = source.indices().to_vec();
+            rows.push(vertex_row(
+                &queries, d, q, target, &renderer, &name, ratio, lod, triangles, &drawn, topology,
+            )?);
+        }
+    }
+    // Share by share, finest first; methods in the order measured.
+    rows.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
     let mut model_fit = BTreeMap::new();
     for (name, _) in REPORTED_MODELS {
         let logs: Option<Vec<f64>> = rows
@@ -213,6 +215,61 @@ pub fn measure_vertex_work(
         rows,
         model_fit,
         best_model,
+    })
+}
+
+/// One vertex-work row: `renderer` drawn five times under the queries
+/// (it holds `drawn`, `triangles` triangles of `method` at `lod`), beside
+/// each cache model's invocations for `drawn`.
+#[allow(clippy::too_many_arguments)]
+fn vertex_row(
+    queries: &mts_render::DrawQueries,
+    d: &wgpu::Device,
+    q: &wgpu::Queue,
+    target: &HeadlessTarget,
+    renderer: &StripRenderer,
+    method: &str,
+    ratio: f64,
+    lod: usize,
+    triangles: usize,
+    drawn: &[u32],
+    topology: mts::strip::vertex_work::Topology,
+) -> Result<VertexRow> {
+    use mts::strip::vertex_work::{vertex_work, REPORTED_MODELS};
+    let mut times = Vec::new();
+    let mut counts = None;
+    for _ in 0..5 {
+        let m = queries.measure(d, q, target, |pass| renderer.draw(pass))?;
+        counts = m.counts;
+        times.extend(m.gpu_ms);
+    }
+    times.sort_by(f64::total_cmp);
+    let mut modelled = BTreeMap::new();
+    let mut ratios = BTreeMap::new();
+    for (name, cache) in REPORTED_MODELS {
+        let w = vertex_work(drawn, topology, cache);
+        modelled.insert(name.to_string(), w.invocations);
+        ratios.insert(
+            name.to_string(),
+            counts.map(|c| c.vertex_invocations as f64 / w.invocations.max(1) as f64),
+        );
+    }
+    Ok(VertexRow {
+        ratio,
+        lod: lod as u64,
+        triangles: triangles as u64,
+        method: method.to_string(),
+        indices_sent: drawn.len() as u64,
+        vertex_invocations: counts.map(|c| c.vertex_invocations),
+        invocations_per_triangle: counts
+            .map(|c| c.vertex_invocations as f64 / triangles.max(1) as f64),
+        clipper_invocations: counts.map(|c| c.clipper_invocations),
+        primitives_assembled: assembled(drawn, topology) as u64,
+        clipper_matches_triangles: counts.map(|c| c.clipper_invocations == triangles as u64),
+        fragment_invocations: counts.map(|c| c.fragment_invocations),
+        gpu_ms: times.get(times.len() / 2).copied(),
+        modelled,
+        measured_over_modelled: ratios,
     })
 }
 
