@@ -435,6 +435,10 @@ struct StripsArgs {
     /// Do not join strips whose ends are neighbours.
     #[arg(long)]
     no_join: bool,
+    /// Short strips side by side in vertex-cache order (see
+    /// StripifyOptions::cache_aware; the options above are then ignored).
+    #[arg(long)]
+    cache_aware: bool,
 }
 
 #[derive(Args)]
@@ -629,6 +633,7 @@ fn strips(args: &StripsArgs) -> Result<()> {
             None => defaults.swap_penalties,
         },
         join_ends: !args.no_join,
+        cache_aware: args.cache_aware,
     };
     let (ours, ms) = median_ms(args.repeat, || stripify(&mesh, &options));
     let skipped = peers::meshopt::refusal(&mesh);
