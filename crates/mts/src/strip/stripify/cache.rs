@@ -1,9 +1,11 @@
 //! The cache-aware local pass: short strips laid side by side, in the order
 //! a vertex cache reuses.
 //!
-//! After Hoppe, "Optimization of mesh locality for transparent vertex
-//! caching" (SIGGRAPH 1999, section 4: strips grown against a simulated
-//! FIFO, each next strip begun beside the previous strip's first face). The
+//! After the strip growing of Hoppe, "Optimization of mesh locality for
+//! transparent vertex caching" (SIGGRAPH 1999): strips grown against a
+//! simulated FIFO, each next strip begun beside the previous one's first
+//! face (followed from memory of the paper, which is not in
+//! `../shared/papers`; the stopping rules are ours). The
 //! pass simulates a FIFO of [`CACHE_SIZE`] vertices over the triangles in the
 //! order it takes them. A strip grows forward only (its run is encoded front
 //! first), prefers a neighbour whose new vertex is cached, and stops when it
@@ -30,7 +32,8 @@ pub(super) struct VertexFifo {
     stamp: Vec<u32>,
     /// Misses so far, plus `CACHE_SIZE + 1` so that stamp 0 is never held.
     now: u32,
-    /// The cached vertices, oldest first, as a ring indexed by `now`.
+    /// The cached vertices as a ring: slot `now % CACHE_SIZE` holds the
+    /// oldest (or `u32::MAX` before the cache fills).
     ring: [u32; CACHE_SIZE as usize],
     /// Misses since the current strip started.
     strip_misses: u32,
