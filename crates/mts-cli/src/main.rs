@@ -293,12 +293,21 @@ struct BuildArgs {
     /// Optimal placement in the contraction sequence (new vertices).
     #[arg(long)]
     optimal: bool,
+    /// Cache-aware strips for LoD 0 and every band (see
+    /// StripifyOptions::cache_aware).
+    #[arg(long)]
+    cache_aware: bool,
 }
 
 impl BuildArgs {
     fn pipeline_options(&self) -> mts::model::PipelineOptions {
         use mts::simplify::{Placement, SimplifyOptions};
+        let bands = mts::model::BuildOptions::default().stripify;
         mts::model::PipelineOptions {
+            stripify: StripifyOptions {
+                cache_aware: self.cache_aware,
+                ..StripifyOptions::default()
+            },
             simplify: SimplifyOptions {
                 placement: if self.optimal {
                     Placement::Optimal
@@ -313,9 +322,11 @@ impl BuildArgs {
                 } else {
                     self.band_slack
                 },
-                ..mts::model::BuildOptions::default()
+                stripify: StripifyOptions {
+                    cache_aware: self.cache_aware,
+                    ..bands
+                },
             },
-            ..Default::default()
         }
     }
 }
@@ -435,6 +446,10 @@ struct StripsArgs {
     /// Do not join strips whose ends are neighbours.
     #[arg(long)]
     no_join: bool,
+    /// Short strips side by side in vertex-cache order (see
+    /// StripifyOptions::cache_aware; the options above are then ignored).
+    #[arg(long)]
+    cache_aware: bool,
 }
 
 #[derive(Args)]
@@ -629,6 +644,7 @@ fn strips(args: &StripsArgs) -> Result<()> {
             None => defaults.swap_penalties,
         },
         join_ends: !args.no_join,
+        cache_aware: args.cache_aware,
     };
     let (ours, ms) = median_ms(args.repeat, || stripify(&mesh, &options));
     let skipped = peers::meshopt::refusal(&mesh);

@@ -22,6 +22,25 @@ fn single_band() -> BuildOptions {
     }
 }
 
+/// Bands stripified by the cache-aware pass (the `.mts` file records it).
+fn cache_aware() -> BuildOptions {
+    let d = BuildOptions::default();
+    BuildOptions {
+        stripify: StripifyOptions {
+            cache_aware: true,
+            ..d.stripify
+        },
+        ..d
+    }
+}
+
+#[test]
+fn cache_aware_bands_hold_the_invariant() {
+    let mesh: Mesh = "icosphere:5k".parse::<Generated>().unwrap().build();
+    let m = build(&mesh, &SimplifyOptions::default(), &cache_aware());
+    check_lods(&mesh, &m, 7);
+}
+
 fn build(mesh: &Mesh, simplify: &SimplifyOptions, options: &BuildOptions) -> MtsModel {
     let strips = stripify(mesh, &StripifyOptions::default());
     let collapses = mts::simplify(mesh, simplify).collapses;
@@ -196,7 +215,7 @@ fn coherent_equals_scratch_on_every_sequence() {
 #[test]
 fn file_round_trip_builds_the_same_model() {
     let mesh: Mesh = "icosphere:5k".parse::<Generated>().unwrap().build();
-    for options in [BuildOptions::default(), single_band()] {
+    for options in [BuildOptions::default(), single_band(), cache_aware()] {
         let m = build(&mesh, &SimplifyOptions::default(), &options);
         let bytes = m.to_bytes();
         let back = MtsModel::from_bytes(&bytes, Path::new("mem.mts")).unwrap();

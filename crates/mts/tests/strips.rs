@@ -59,7 +59,7 @@ fn check(mesh: &Mesh, options: &StripifyOptions) -> Strips {
     strips
 }
 
-fn all_options() -> [StripifyOptions; 3] {
+fn all_options() -> [StripifyOptions; 4] {
     let d = StripifyOptions::default();
     [
         d,
@@ -71,6 +71,10 @@ fn all_options() -> [StripifyOptions; 3] {
         StripifyOptions {
             min_patch_quads: 1,
             swap_penalties: [Some(3.0), None],
+            ..d
+        },
+        StripifyOptions {
+            cache_aware: true,
             ..d
         },
     ]
@@ -180,6 +184,38 @@ fn generated_meshes_send_fewer_indices_than_meshoptimizer() {
 /// A random mesh: a jittered grid with holes, some triangles flipped,
 /// duplicated or fanned onto a shared edge (non-manifold), plus a second
 /// component, with vertex indices shuffled.
+/// FIFO-16 ACMR of the strips' triangle order.
+fn strip_acmr(s: &Strips) -> f64 {
+    use mts::strip::acmr::{fifo_acmr, CACHE_SIZE};
+    fifo_acmr(&s.triangles(), s.vertex_count() as usize, CACHE_SIZE)
+}
+
+#[test]
+fn cache_aware_strips_reuse_more_vertices() {
+    let cache_aware = StripifyOptions {
+        cache_aware: true,
+        ..StripifyOptions::default()
+    };
+    // (mesh, default ACMR, cache-aware ACMR, cache-aware indices per
+    // triangle), to three decimals.
+    let cases = [
+        (generate::grid(60, 40), 1.0, 0.826, 1.325),
+        (generate::torus(100, 50), 1.0, 0.967, 1.355),
+        (generate::icosphere(20, 0.08, 1), 0.997, 0.944, 1.36),
+    ];
+    for (m, plain_acmr, acmr, per_triangle) in cases {
+        let plain = check(&m, &StripifyOptions::default());
+        let ours = check(&m, &cache_aware);
+        let r = |x: f64| (x * 1000.0).round() / 1000.0;
+        let ipt = ours.restart_index_count() as f64 / ours.triangle_count() as f64;
+        assert_eq!(
+            (r(strip_acmr(&plain)), r(strip_acmr(&ours)), r(ipt)),
+            (plain_acmr, acmr, per_triangle)
+        );
+        assert!(strip_acmr(&ours) < strip_acmr(&plain));
+    }
+}
+
 fn random_mesh() -> impl Strategy<Value = Mesh> {
     (
         2u32..12,

@@ -21,7 +21,8 @@
 //! - `META`: varints vertex count, appended vertex count, run count, strip
 //!   index count, step count; then band slack (f64), the band stripifier's
 //!   options (patches u8, min patch quads varint, two swap penalties as f32
-//!   with NaN for none, join ends u8), optimal placement u8.
+//!   with NaN for none, join ends u8 with the cache-aware option as bit 1),
+//!   optimal placement u8.
 //! - `POSI`: `3 × f32` per vertex (input vertices, then appended ones).
 //! - `STRP`: each run's length (varint), then every index as a zigzag
 //!   varint of its difference from the previous index.
@@ -82,7 +83,7 @@ impl MtsModel {
         for p in so.swap_penalties {
             meta.extend_from_slice(&p.unwrap_or(f32::NAN).to_le_bytes());
         }
-        meta.push(u8::from(so.join_ends));
+        meta.push(u8::from(so.join_ends) | u8::from(so.cache_aware) << 1);
         meta.push(u8::from(c.is_optimal_placement()));
 
         let mut posi = Vec::with_capacity(12 * self.positions.len());
@@ -457,7 +458,13 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         }
         *p = (!v.is_nan()).then_some(v);
     }
-    let join_ends = flag(&mut meta, "join ends")?;
+    let (join_ends, cache_aware) = match meta.u8()? {
+        b @ 0..=3 => (b & 1 != 0, b & 2 != 0),
+        b => {
+            meta.pos -= 1;
+            return Err(meta.error(format!("join ends byte is {b}, not 0 to 3")));
+        }
+    };
     let optimal = flag(&mut meta, "optimal placement")?;
     meta.finish()?;
     if optimal != (appended > 0) && !(optimal && steps == 0) {
@@ -597,6 +604,7 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
                 min_patch_quads,
                 swap_penalties,
                 join_ends,
+                cache_aware,
             },
         },
     })

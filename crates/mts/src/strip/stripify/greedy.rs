@@ -7,6 +7,7 @@
 //! side allows it, and when it cannot go on it grows again from its start in
 //! the other direction.
 
+use super::cache::VertexFifo;
 use super::path::{pivot, slot_to};
 use crate::mesh::{TriangleAdjacency, NO_NEIGHBOUR};
 
@@ -50,6 +51,11 @@ impl<'a> Walk<'a> {
         }
     }
 
+    /// Free neighbours of the free triangle `t`.
+    pub(super) fn free_neighbours(&self, t: u32) -> u8 {
+        self.free_deg[t as usize]
+    }
+
     pub(super) fn is_free(&self, t: u32) -> bool {
         t != NO_NEIGHBOUR && self.free_deg[t as usize] != TAKEN
     }
@@ -69,7 +75,7 @@ impl<'a> Walk<'a> {
 
     /// The free triangle with fewest free neighbours; the most recently
     /// updated one on a tie, which keeps new strips next to the last.
-    fn pop_start(&mut self) -> Option<u32> {
+    pub(super) fn pop_start(&mut self) -> Option<u32> {
         for d in 0..4 {
             while let Some(t) = self.buckets[d].pop() {
                 if self.free_deg[t as usize] as usize == d {
@@ -85,7 +91,11 @@ impl<'a> Walk<'a> {
     /// The candidate score is the candidate's free-neighbour count plus the
     /// swap penalty if entering it needs a swap (see the `path` module:
     /// a swap is three consecutive shared edges around one vertex).
-    pub(super) fn grow_back(&mut self, path: &mut Vec<u32>) {
+    ///
+    /// With a `cache` (the cache-aware pass), a candidate whose new vertex
+    /// is cached scores [`VertexFifo::HIT_BONUS`] less, each new vertex goes
+    /// through the cache, and growth stops where [`VertexFifo::step`] says.
+    pub(super) fn grow_back(&mut self, path: &mut Vec<u32>, mut cache: Option<&mut VertexFifo>) {
         let n = path.len();
         let mut cur = path[n - 1];
         // Entry slot of `cur`, carried from step to step.
@@ -116,8 +126,13 @@ impl<'a> Walk<'a> {
                     (Some(e), Some(p)) => pivot_slot(e, s) == p,
                     _ => false,
                 };
-                let score = f32::from(self.free_deg[cand as usize])
+                let mut score = f32::from(self.free_deg[cand as usize])
                     + if swap { self.swap_penalty } else { 0.0 };
+                if let Some(c) = cache.as_deref() {
+                    if c.holds(apex(self.tris, self.adj, cur, s)) {
+                        score -= VertexFifo::HIT_BONUS;
+                    }
+                }
                 if best.is_none_or(|(b, _)| score < b) {
                     best = Some((score, s));
                 }
@@ -137,9 +152,21 @@ impl<'a> Walk<'a> {
             entry = Some(next_entry);
             self.take(next);
             path.push(next);
+            if let Some(c) = cache.as_deref_mut() {
+                if c.step(self.tris[next as usize][(next_entry + 2) % 3]) {
+                    return;
+                }
+            }
             cur = next;
         }
     }
+}
+
+/// The vertex of `cur`'s neighbour across slot `s` that is not on their
+/// shared edge.
+fn apex(tris: &[[u32; 3]], adj: &TriangleAdjacency, cur: u32, s: usize) -> u32 {
+    let next = adj.neighbours[cur as usize][s];
+    tris[next as usize][(adj.mate(cur, s) + 2) % 3]
 }
 
 /// The position in a triangle of the vertex shared by its edge slots `a`
@@ -159,9 +186,9 @@ pub(super) fn strip_rest(walk: &mut Walk<'_>, paths: &mut Vec<Vec<u32>>) {
     while let Some(start) = walk.pop_start() {
         walk.take(start);
         let mut path = vec![start];
-        walk.grow_back(&mut path);
+        walk.grow_back(&mut path, None);
         path.reverse();
-        walk.grow_back(&mut path);
+        walk.grow_back(&mut path, None);
         paths.push(path);
     }
 }

@@ -57,13 +57,23 @@ fn start_swap(path: &[u32], tris: &[[u32; 3]], adj: &TriangleAdjacency) -> bool 
     pivot(t1, in1, out1) == t0[e0]
 }
 
-/// Appends the run of `path` to `out`, starting from whichever end costs
-/// fewer swaps (the front on a tie).
+/// Appends the run of `path` to `out`, starting from the front, or, if
+/// `reverse_if_cheaper`, from whichever end costs fewer swaps (the front
+/// on a tie).
 ///
 /// Cost: O(path length).
-pub(super) fn encode(path: &[u32], tris: &[[u32; 3]], adj: &TriangleAdjacency, out: &mut Vec<u32>) {
+pub(super) fn encode(
+    path: &[u32],
+    tris: &[[u32; 3]],
+    adj: &TriangleAdjacency,
+    reverse_if_cheaper: bool,
+    out: &mut Vec<u32>,
+) {
     let reversed: Vec<u32>;
-    let path = if start_swap(path, tris, adj) && !start_swap_reversed(path, tris, adj) {
+    let path = if reverse_if_cheaper
+        && start_swap(path, tris, adj)
+        && !start_swap_reversed(path, tris, adj)
+    {
         reversed = path.iter().rev().copied().collect();
         &reversed[..]
     } else {
