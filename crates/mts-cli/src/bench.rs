@@ -269,34 +269,41 @@ fn scene_table(s: &mut String, rows: &[Scene]) {
         "\n## Scene: many instances of several models, LoD by screen-space error, shared buffers\n"
     );
     let _ = writeln!(s, "`mts bench render --scene`'s rows on Figure 6's adapter: instances of {} ({}) scaled to one radius on a ground plane, {}×{} pixels, a camera flying through the field ({} frames). Each visible instance gets the coarsest LoD whose recorded error projects within the threshold, and draws the shared buffer of its LoD bucket (10% fewer triangles a bucket), one instanced draw per (model, bucket). Update: cull, LoD choice, extractions, uploads; frame: update and draw. GPU: peak bucket buffers and transforms, against the sum of the models' full-detail strip buffers. Image: pixels covered by instances that differ at all from the same frame at full detail ({} frames of the path).\n", first.models, first.model_names.join(", "), first.width, first.height, first.frames, first.compared_frames);
-    let _ = writeln!(s, "| instances | px | visible | triangles (share of full) | draws | extractions / frame | update ms median / p99 | frame ms | CPU B / instance | GPU MB (× full strips) | buffers | pixels differing (by > {}/255; in coverage) |", super::figure6::IMAGE_TOLERANCE);
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "{}", scene_table_head());
     for r in rows {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {:.0} | {:.0} ({:.2}%) | {:.1} | {:.2} | {:.2} / {:.2} | {:.1} | {} | {:.2} ({:.2}×) | {} | {} ({}; {}) |",
-            r.instances,
-            r.pixel_threshold,
-            r.visible,
-            r.triangles_drawn,
-            100.0 * r.triangles_drawn / r.triangles_full_detail.max(1.0),
-            r.draws,
-            r.extractions_per_frame,
-            r.update_ms_median,
-            r.update_ms_p99,
-            r.frame_ms_median,
-            r.cpu_bytes_per_instance,
-            r.gpu_bytes as f64 / 1e6,
-            r.gpu_bytes as f64 / r.full_detail_strip_bytes.max(1) as f64,
-            r.buffers,
-            r.differing_pixel_share
-                .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
-            r.visibly_differing_pixel_share
-                .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
-            r.coverage_differing_pixel_share
-                .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
-        );
+        let _ = writeln!(s, "{}", scene_table_row(r));
     }
+}
+
+/// The head of the scene table (the report's, and `mts bench render
+/// --scene`'s text).
+pub fn scene_table_head() -> String {
+    format!("| instances | px | visible | triangles (share of full) | draws | extractions / frame | update ms median / p99 | frame ms | CPU B / instance | GPU MB (× full strips) | buffers | pixels differing (by > {}/255; in coverage) |\n|---|---|---|---|---|---|---|---|---|---|---|---|", super::figure6::IMAGE_TOLERANCE)
+}
+
+/// One scene row of [`scene_table_head`]'s table.
+pub fn scene_table_row(r: &Scene) -> String {
+    let share = |x: Option<f64>| x.map_or("—".into(), |x| format!("{:.3}%", 100.0 * x));
+    format!(
+        "| {} | {} | {:.0} | {:.0} ({:.2}%) | {:.1} | {:.2} | {:.2} / {:.2} | {:.1} | {} | {:.2} ({:.2}×) | {} | {} ({}; {}) |",
+        r.instances,
+        r.pixel_threshold,
+        r.visible,
+        r.triangles_drawn,
+        100.0 * r.triangles_drawn / r.triangles_full_detail.max(1.0),
+        r.draws,
+        r.extractions_per_frame,
+        r.update_ms_median,
+        r.update_ms_p99,
+        r.frame_ms_median,
+        r.cpu_bytes_per_instance,
+        r.gpu_bytes as f64 / 1e6,
+        r.gpu_bytes as f64 / r.full_detail_strip_bytes.max(1) as f64,
+        r.buffers,
+        share(r.differing_pixel_share),
+        share(r.visibly_differing_pixel_share),
+        share(r.coverage_differing_pixel_share),
+    )
 }
 
 /// The report's section on vertex properties.

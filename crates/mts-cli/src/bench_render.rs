@@ -509,35 +509,16 @@ fn bench_scene(
 /// One scene row as text.
 pub fn print_scene(r: &Scene) {
     println!(
-        "scene: {} instances of {} models at {} px: {:.0} visible, {:.0} of {:.0} triangles \
-         ({:.1}%), {:.1} draws, {:.2} extractions a frame; update {:.2} ms median, {:.2} ms p99; \
-         frame {:.2} ms; {} B CPU per instance, GPU {:.1} MB ({:.2} x the full-detail strips) \
-         in {} buffers; {} of the covered pixels differ from full detail ({} by more than {} \
-         of 255, {} in coverage)",
+        "scene: {} instances of {} models ({}), {}×{} pixels, {} frames along the path:",
         r.instances,
         r.models,
-        r.pixel_threshold,
-        r.visible,
-        r.triangles_drawn,
-        r.triangles_full_detail,
-        100.0 * r.triangles_drawn / r.triangles_full_detail.max(1.0),
-        r.draws,
-        r.extractions_per_frame,
-        r.update_ms_median,
-        r.update_ms_p99,
-        r.frame_ms_median,
-        r.cpu_bytes_per_instance,
-        r.gpu_bytes as f64 / 1e6,
-        r.gpu_bytes as f64 / r.full_detail_strip_bytes.max(1) as f64,
-        r.buffers,
-        r.differing_pixel_share
-            .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
-        r.visibly_differing_pixel_share
-            .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
-        crate::figure6::IMAGE_TOLERANCE,
-        r.coverage_differing_pixel_share
-            .map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)),
+        r.model_names.join(", "),
+        r.width,
+        r.height,
+        r.frames
     );
+    println!("{}", super::bench::scene_table_head());
+    println!("{}", super::bench::scene_table_row(r));
 }
 
 /// Frames of the path compared with full detail by `mts bench render`.
