@@ -234,8 +234,10 @@ pub struct InstancedScene<'m> {
     refits: u32,
     stack: Vec<u32>,
     candidates: Vec<u32>,
-    /// Visible instances of the last update, ascending.
+    /// Visible instances of the last update, ascending, and of the one
+    /// before (kept to reuse its allocation and to see who left the view).
     visible: Vec<InstanceId>,
+    previous: Vec<InstanceId>,
     instance_buffer: Option<wgpu::Buffer>,
     instance_capacity: usize,
     compact: Vec<u32>,
@@ -272,6 +274,7 @@ impl<'m> InstancedScene<'m> {
             stack: Vec::new(),
             candidates: Vec::new(),
             visible: Vec::new(),
+            previous: Vec::new(),
             instance_buffer: None,
             instance_capacity: 0,
             compact: Vec::new(),
@@ -514,7 +517,8 @@ impl<'m> InstancedScene<'m> {
         m.cpu_instance_bytes += self.order.capacity() * std::mem::size_of::<InstanceId>()
             + self.candidates.capacity() * 4
             + self.stack.capacity() * 4
-            + self.visible.capacity() * std::mem::size_of::<InstanceId>();
+            + (self.visible.capacity() + self.previous.capacity())
+                * std::mem::size_of::<InstanceId>();
         if let Some(bvh) = &self.bvh {
             m.cpu_instance_bytes += bvh.nodes.capacity()
                 * std::mem::size_of::<obvhs::bvh2::node::Bvh2Node>()
@@ -591,11 +595,12 @@ impl<'m> InstancedScene<'m> {
         let row_y = camera.view_proj.row(1).truncate().length();
         let row_w = camera.view_proj.row(3);
         let px_at_1 = row_y * 0.5 * viewport_height;
-        let previous = std::mem::take(&mut self.visible);
+        std::mem::swap(&mut self.visible, &mut self.previous);
+        self.visible.clear();
         self.visible
             .extend(self.candidates.iter().map(|&i| self.order[i as usize]));
         self.visible.sort_unstable();
-        for &id in &previous {
+        for &id in &self.previous {
             if self.visible.binary_search(&id).is_err() {
                 if let Some(s) = self.models[id.model as usize]
                     .slots
@@ -654,6 +659,7 @@ impl<'m> InstancedScene<'m> {
                 groups += b.users;
                 stats.draws += 1;
                 if b.buffer.is_some() {
+                    stats.indices_drawn += b.users as usize * b.len as usize;
                     continue;
                 }
                 entry.cursor.set_lod(b.lod as usize);
@@ -670,17 +676,9 @@ impl<'m> InstancedScene<'m> {
                 b.buffer = Some(buffer);
                 stats.upload_bytes += bytes;
                 stats.extractions += 1;
+                stats.indices_drawn += b.users as usize * b.len as usize;
             }
         }
-        // Counted once every bucket drawn is extracted.
-        stats.indices_drawn = self
-            .visible
-            .iter()
-            .map(|id| {
-                let entry = &self.models[id.model as usize];
-                entry.buckets[entry.slots[id.slot as usize].bucket as usize].len as usize
-            })
-            .sum();
         stats.upload_bytes += self.write_transforms(device, queue, groups as usize)?;
         stats.visible = self.visible.len();
         Ok(stats)
