@@ -631,12 +631,11 @@ pub fn scene_rows(
             let camera = scene.path_camera(compared_at(k, spec.compared_frames), aspect);
             scene.update(d, q, &camera, h, pixel_error)?;
             let lod = target.render_image(d, q, |pass| scene.scene.draw(pass))?;
-            let exact = full.difference(&lod, 0);
-            let visible = full.difference(&lod, crate::figure6::IMAGE_TOLERANCE);
-            pixels[0] += exact.pixels as f64;
-            pixels[1] += exact.share * exact.pixels as f64;
-            pixels[2] += visible.share * visible.pixels as f64;
-            pixels[3] += exact.coverage_changed as f64;
+            let diff = full.difference(&lod, crate::figure6::IMAGE_TOLERANCE);
+            pixels[0] += diff.pixels as f64;
+            pixels[1] += diff.changed_share * diff.pixels as f64;
+            pixels[2] += diff.share * diff.pixels as f64;
+            pixels[3] += diff.coverage_changed as f64;
         }
         let share = |x: f64| (pixels[0] > 0.0).then(|| x / pixels[0]);
         rows.push(Scene {

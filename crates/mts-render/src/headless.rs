@@ -58,7 +58,8 @@ impl Image {
     /// where either shows the model (differs from its own top-left pixel,
     /// as [`Image::foreground_pixels`]): the share of them whose red, green
     /// or blue byte differs by more than `tolerance`, and the RMS of the
-    /// RGB difference in 0..=1 sRGB units. The tolerance keeps shading
+    /// RGB difference in 0..=1 sRGB units; beside them the share that
+    /// differs at all (`changed_share`). The tolerance keeps shading
     /// that moves by a step or two of rounding from counting as a changed
     /// pixel while a checker square that moved (about 160 steps apart)
     /// always does. Images of different sizes differ everywhere (share 1,
@@ -70,6 +71,7 @@ impl Image {
             return Difference {
                 pixels,
                 share: 1.0,
+                changed_share: 1.0,
                 rms: 1.0,
                 coverage_changed: pixels,
             };
@@ -77,7 +79,8 @@ impl Image {
         let (Some(ca), Some(cb)) = (self.rgba.get(..4), other.rgba.get(..4)) else {
             return Difference::default();
         };
-        let (mut pixels, mut differing, mut sum, mut coverage) = (0usize, 0usize, 0f64, 0usize);
+        let (mut pixels, mut differing, mut changed, mut sum, mut coverage) =
+            (0usize, 0usize, 0usize, 0f64, 0usize);
         for (a, b) in self.rgba.chunks_exact(4).zip(other.rgba.chunks_exact(4)) {
             if a == ca && b == cb {
                 continue;
@@ -91,6 +94,7 @@ impl Image {
                 sum += (f64::from(d) / 255.0).powi(2);
             }
             differing += usize::from(most > tolerance);
+            changed += usize::from(most > 0);
         }
         if pixels == 0 {
             return Difference::default();
@@ -98,6 +102,7 @@ impl Image {
         Difference {
             pixels,
             share: differing as f64 / pixels as f64,
+            changed_share: changed as f64 / pixels as f64,
             rms: (sum / (3 * pixels) as f64).sqrt(),
             coverage_changed: coverage,
         }
@@ -131,6 +136,8 @@ pub struct Difference {
     pub pixels: usize,
     /// Share of those whose colour moved beyond the tolerance.
     pub share: f64,
+    /// Share of those whose colour moved at all.
+    pub changed_share: f64,
     /// RMS of the RGB difference over those pixels, in 0..=1.
     pub rms: f64,
     /// Of those, the pixels that show the model in one image only (the
@@ -437,6 +444,7 @@ mod tests {
         let d = reference.difference(&other, 8);
         assert_eq!(d.pixels, 3);
         assert_eq!(d.coverage_changed, 1);
+        assert!((d.changed_share - 1.0).abs() < 1e-12, "{d:?}");
         assert!((d.share - 2.0 / 3.0).abs() < 1e-12, "{d:?}");
         let sum = (2f64 / 255.0).powi(2) + (160f64 / 255.0).powi(2) + 3.0 * (10f64 / 255.0).powi(2);
         assert!((d.rms - (sum / 9.0).sqrt()).abs() < 1e-12, "{d:?}");
@@ -446,6 +454,7 @@ mod tests {
             Difference {
                 pixels: 2,
                 share: 0.0,
+                changed_share: 0.0,
                 rms: 0.0,
                 coverage_changed: 0
             }
