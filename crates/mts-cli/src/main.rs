@@ -689,52 +689,24 @@ fn strips(args: &StripsArgs) -> Result<()> {
     }
     println!("{:<22}{:>14}{:>14}", "", "mts", "meshopt");
     let peer = peer.unwrap_or_default();
-    let rows: [(&str, String, String); 10] = [
-        (
-            "triangles",
-            mine.triangles.to_string(),
-            peer.triangles.to_string(),
-        ),
-        ("strips", mine.strips.to_string(), peer.strips.to_string()),
-        ("swaps", mine.swaps.to_string(), peer.swaps.to_string()),
-        (
-            "indices (restart)",
-            mine.indices_restart.to_string(),
-            peer.indices_restart.to_string(),
-        ),
-        (
-            "indices / triangle",
-            format!("{:.4}", mine.indices_per_triangle),
-            format!("{:.4}", peer.indices_per_triangle),
-        ),
-        (
-            "ACMR (FIFO 16)",
-            format!("{:.3}", mine.acmr),
-            format!("{:.3}", peer.acmr),
-        ),
-        (
-            "ACMR (batch 96)",
-            format!("{:.3}", mine.acmr_batch96),
-            format!("{:.3}", peer.acmr_batch96),
-        ),
-        (
-            "ACMR (batch 384)",
-            format!("{:.3}", mine.acmr_batch384),
-            format!("{:.3}", peer.acmr_batch384),
-        ),
-        (
-            "ACMR (LRU 32)",
-            format!("{:.3}", mine.acmr_lru32),
-            format!("{:.3}", peer.acmr_lru32),
-        ),
-        (
-            "ms (median)",
-            format!("{:.2}", mine.ms),
-            format!("{:.2}", peer.ms),
-        ),
+    // Each row: its label and the figure of a side.
+    type Figure = fn(&StripStats) -> String;
+    let rows: [(&str, Figure); 10] = [
+        ("triangles", |s| s.triangles.to_string()),
+        ("strips", |s| s.strips.to_string()),
+        ("swaps", |s| s.swaps.to_string()),
+        ("indices (restart)", |s| s.indices_restart.to_string()),
+        ("indices / triangle", |s| {
+            format!("{:.4}", s.indices_per_triangle)
+        }),
+        ("ACMR (FIFO 16)", |s| format!("{:.3}", s.acmr)),
+        ("ACMR (batch 96)", |s| format!("{:.3}", s.acmr_batch96)),
+        ("ACMR (batch 384)", |s| format!("{:.3}", s.acmr_batch384)),
+        ("ACMR (LRU 32)", |s| format!("{:.3}", s.acmr_lru32)),
+        ("ms (median)", |s| format!("{:.2}", s.ms)),
     ];
-    for (label, a, b) in rows {
-        println!("{label:<22}{a:>14}{b:>14}");
+    for (label, figure) in rows {
+        println!("{label:<22}{:>14}{:>14}", figure(&mine), figure(&peer));
     }
     if skipped.is_none() {
         // The list the strips are weighed against: meshoptimizer's
