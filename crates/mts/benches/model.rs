@@ -1,7 +1,8 @@
 //! Criterion: building the MTS model of the bunny (or a generated 70K
 //! icosphere when `../shared/models` is absent): the graphs from strips and
 //! the contraction sequence (one band, and banded), and the whole pipeline
-//! from the mesh. Extraction is in `benches/extract.rs`.
+//! from the mesh; loading the model's `.mts` bytes (parse, validate,
+//! extractor ready). Extraction is in `benches/extract.rs`.
 
 mod common;
 
@@ -41,6 +42,18 @@ fn bench(c: &mut Criterion) {
                 &mut |_, _| {},
             )
         });
+    });
+    let model = build(&mesh, &strips, &collapses, &BuildOptions::default());
+    let bytes = model.to_bytes();
+    let file = std::path::Path::new("model.mts");
+    group.bench_function("load_ready", |b| {
+        b.iter(|| {
+            let m = mts::MtsModel::from_bytes(black_box(&bytes), file).expect("loads");
+            black_box(mts::Extractor::new(&m).buffer().len())
+        });
+    });
+    group.bench_function("validate", |b| {
+        b.iter(|| black_box(&model).validate());
     });
     group.finish();
 }

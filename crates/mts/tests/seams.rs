@@ -37,8 +37,8 @@ fn seams_stay_closed_and_never_multiply() {
 
 /// The MTS model of a mesh with seams: the extractor draws the oracle's
 /// triangles at every LoD checked (so every corner's properties are the
-/// oracle's: they belong to the vertices), and the version-2 file gives
-/// the same model back.
+/// oracle's: they belong to the vertices), and the ready (version-3) file
+/// and the recipe-only (version-2) file give the same model back.
 #[test]
 fn models_of_seamed_meshes_match_the_oracle_and_round_trip() {
     use mts::model::build_from_mesh;
@@ -52,9 +52,14 @@ fn models_of_seamed_meshes_match_the_oracle_and_round_trip() {
         model.validate().unwrap();
         assert_eq!(model.properties(), &mesh.properties, "{name}");
         assert!(model.collapses().has_companions(), "{name}");
+        let recipe = model.to_recipe_bytes();
+        assert_eq!(u32::from_le_bytes(recipe[8..12].try_into().unwrap()), 2);
+        let built = MtsModel::from_bytes(&recipe, std::path::Path::new(name)).unwrap();
+        assert_eq!(built, model, "{name}");
         let bytes = model.to_bytes();
-        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
+        assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 3);
         let back = MtsModel::from_bytes(&bytes, std::path::Path::new(name)).unwrap();
+        assert_eq!(back, model, "{name}");
         assert_eq!(back.properties(), model.properties(), "{name}");
         assert_eq!(back.collapses(), model.collapses(), "{name}");
         let (mut ex, mut ex_back) = (Extractor::new(&model), Extractor::new(&back));

@@ -53,6 +53,7 @@
 //! windows. So construction costs O(positions + total strip changes), not
 //! strips × LoDs.
 
+use super::records::{Records, Wide};
 use super::{MtsModel, Recipe, END, NODE_MASK, RESTART};
 use crate::mesh::Mesh;
 use crate::simplify::Collapses;
@@ -240,18 +241,36 @@ pub fn build_with_progress(
     for part in parts {
         graphs.append(part);
     }
-    let model = MtsModel {
+    let mut strip_birth = vec![0u32; graphs.strip_nodes.len() - 1];
+    for (b, &first) in graphs.band_lod.iter().enumerate() {
+        for s in graphs.band_strips[b]..graphs.band_strips[b + 1] {
+            strip_birth[s as usize] = first;
+        }
+    }
+    let records = Records::pack(&Wide {
+        strip_nodes: &graphs.strip_nodes,
+        begin_node: &graphs.begin_node,
+        node_vertex: &graphs.node_vertex,
+        node_arcs: &graphs.node_arcs,
+        arc_target: &graphs.arc_target,
+        arc_res: &graphs.arc_res,
+        strip_birth: &strip_birth,
+    });
+    drop(graphs.node_vertex);
+    drop(graphs.arc_target);
+    let mut model = MtsModel {
         positions: ctx.positions,
         properties: mesh.properties.clone(),
-        strip_nodes: graphs.strip_nodes,
+        strip_records: records.strip_records,
         strip_begins: graphs.strip_begins,
         band_strips: graphs.band_strips,
-        begin_node: graphs.begin_node,
+        begin_node: records.begin_record,
         begin_res: graphs.begin_res,
-        node_vertex: graphs.node_vertex,
-        node_arcs: graphs.node_arcs,
-        arc_target: graphs.arc_target,
-        arc_res: graphs.arc_res,
+        rec_vertex: records.vertex,
+        rec_label: records.label,
+        rec_code: records.code,
+        far: records.far,
+        slot_size: Vec::new(),
         band_lod: graphs.band_lod,
         recipe: Recipe {
             strips: strips.clone(),
@@ -259,6 +278,7 @@ pub fn build_with_progress(
             options: options.clone(),
         },
     };
+    model.slot_size = slot_sizes(&model, &strip_birth);
     debug_assert_eq!(model.validate(), Ok(()));
     model
 }
@@ -1003,6 +1023,19 @@ fn find_live(links: &mut [u32], mut w: u32) -> Option<u32> {
     }
 }
 
+/// Each strip's sequence length at its band's first LoD: the longest it
+/// gets ("Monotone" above), so the extractor's slot size.
+fn slot_sizes(model: &MtsModel, strip_birth: &[u32]) -> Vec<u32> {
+    let mut scratch = Vec::new();
+    (0..model.strip_count())
+        .map(|s| {
+            // A node emits its vertex and at most one break.
+            scratch.resize(2 * model.records_of(s).len() + 1, 0);
+            super::extract::walk(model, s, strip_birth[s], strip_birth[s], &mut scratch).len
+        })
+        .collect()
+}
+
 fn prefix_sum(v: &mut [u32]) {
     for i in 1..v.len() {
         v[i] += v[i - 1];
@@ -1135,10 +1168,14 @@ mod tests {
             properties: Default::default(),
         };
         let (model, collapses) = model_of(&mesh, &strips, &[]);
-        let ones = model.node_vertex.iter().filter(|&&v| v == 1).count();
+        let records = model.rec_code.len();
+        let ones = (0..records)
+            .filter(|&r| model.starts_node(r, 0) && model.rec_vertex.get(r) == 1)
+            .count();
         assert_eq!(ones, 2, "one node per occurrence");
         // Each node has exactly one arc, so no walk has to choose.
-        assert_eq!(model.arc_target.len(), model.node_vertex.len());
+        let stats = model.stats();
+        assert_eq!((stats.nodes, stats.arcs), (5, 5));
         assert_eq!(
             sequences(&mesh, &model, &collapses),
             vec![vec![0, 1, 2, 1, 3]]

@@ -20,7 +20,8 @@
 //! one extractor per instance. Changing band rewrites the band's region
 //! (one dirty range).
 
-use super::{MtsModel, END, NODE_MASK, RESTART};
+use super::records::{Narrow, Word, BREAK, DISTANCE, FAR, MORE, NO_ARC};
+use super::{MtsModel, END};
 use crate::strip::encode::RESTART_U32;
 use std::ops::Range;
 
@@ -67,37 +68,26 @@ pub struct Extractor<'m> {
 }
 
 /// Result of walking one strip.
-struct Walk {
-    len: u32,
-    from: u32,
-    to: u32,
-    overflow: bool,
+pub(crate) struct Walk {
+    pub(crate) len: u32,
+    pub(crate) from: u32,
+    pub(crate) to: u32,
+    pub(crate) overflow: bool,
 }
 
 impl<'m> Extractor<'m> {
     /// An extractor for `model`, with nothing extracted yet (the buffer is
-    /// all restarts). Cost: one walk of every strip at LoD 0 to size the
-    /// slots.
+    /// all restarts). Cost: O(strips); the slot sizes come with the model.
     #[must_use]
     pub fn new(model: &'m MtsModel) -> Extractor<'m> {
         let strips = model.strip_count();
         let mut slot_start = Vec::with_capacity(strips);
-        let mut slot_size = Vec::with_capacity(strips);
         let mut band_len = Vec::with_capacity(model.band_count());
-        // The walk at the band's first LoD bounds every later one; a node
-        // count bound keeps the sizing walk itself in range on a corrupt
-        // model.
-        let mut scratch = Vec::new();
         for b in 0..model.band_count() {
-            let birth = model.band_first_lod(b) as u32;
             let mut at = 0u32;
             for s in model.band_strips(b) {
-                let nodes = model.nodes_of(s).len();
-                scratch.resize(2 * nodes + 1, 0);
-                let w = walk(model, s, birth, &mut scratch);
                 slot_start.push(at);
-                slot_size.push(w.len);
-                at += w.len + 1;
+                at += model.slot_size[s] + 1;
             }
             band_len.push(at);
         }
@@ -106,7 +96,7 @@ impl<'m> Extractor<'m> {
             model,
             buffer: vec![RESTART_U32; total],
             slot_start,
-            slot_size,
+            slot_size: model.slot_size.clone(),
             band_len,
             len: vec![0; strips],
             valid_from: vec![1; strips],
@@ -173,8 +163,9 @@ impl<'m> Extractor<'m> {
                 self.dirty.push(0..region);
             }
         }
+        let birth = model.band_first_lod(band) as u32;
         for s in model.band_strips(band) {
-            walked += usize::from(self.refresh(s, lod as u32, coherent));
+            walked += usize::from(self.refresh(s, birth, lod as u32, coherent));
         }
         self.lod = Some(lod);
         self.band = Some(band);
@@ -187,13 +178,13 @@ impl<'m> Extractor<'m> {
 
     /// Walks strip `s` at `lod` into its slot unless (when `coherent`) its
     /// validity interval holds `lod`. Returns whether it walked.
-    fn refresh(&mut self, s: usize, lod: u32, coherent: bool) -> bool {
+    fn refresh(&mut self, s: usize, birth: u32, lod: u32, coherent: bool) -> bool {
         if coherent && self.valid_from[s] <= lod && lod <= self.valid_to[s] {
             return false;
         }
         let start = self.slot_start[s] as usize;
         let slot = start..start + self.slot_size[s] as usize;
-        let w = walk(self.model, s, lod, &mut self.buffer[slot]);
+        let w = walk(self.model, s, birth, lod, &mut self.buffer[slot]);
         self.overflows += usize::from(w.overflow);
         self.set_len(s, w.len as usize);
         self.valid_from[s] = w.from;
@@ -299,10 +290,27 @@ impl<'m> Extractor<'m> {
     }
 }
 
-/// Walks strip `s` at LoD `lod` into `out` (Fig. 5 of the paper), tracking
-/// the validity interval: the largest label skipped bounds it below, the
-/// smallest label taken above.
-fn walk(model: &MtsModel, s: usize, lod: u32, out: &mut [u32]) -> Walk {
+/// Walks strip `s` (of a band born at LoD `birth`) at LoD `lod` into
+/// `out` (Fig. 5 of the paper), tracking the validity interval: the largest
+/// label skipped bounds it below, the smallest label taken above.
+pub(crate) fn walk(model: &MtsModel, s: usize, birth: u32, lod: u32, out: &mut [u32]) -> Walk {
+    match (&model.rec_vertex, &model.rec_label) {
+        (Narrow::U16(v), Narrow::U16(l)) => walk_records(model, v, l, s, birth, lod, out),
+        (Narrow::U16(v), Narrow::U32(l)) => walk_records(model, v, l, s, birth, lod, out),
+        (Narrow::U32(v), Narrow::U16(l)) => walk_records(model, v, l, s, birth, lod, out),
+        (Narrow::U32(v), Narrow::U32(l)) => walk_records(model, v, l, s, birth, lod, out),
+    }
+}
+
+fn walk_records<V: Word, L: Word>(
+    model: &MtsModel,
+    vertex: &[V],
+    label: &[L],
+    s: usize,
+    birth: u32,
+    lod: u32,
+    out: &mut [u32],
+) -> Walk {
     let mut w = Walk {
         len: 0,
         from: 0,
@@ -323,31 +331,41 @@ fn walk(model: &MtsModel, s: usize, lod: u32, out: &mut [u32]) -> Walk {
     if node == END {
         return w;
     }
+    // The beginnings put `lod` inside the band, so labels compare relative
+    // to its first LoD.
+    let rel = lod.saturating_sub(birth);
+    let code = &model.rec_code[..];
     let mut len = 0usize;
-    let mut n = (node & NODE_MASK) as usize;
-    let mut start = model.node_arcs[n] as usize;
-    loop {
+    let mut r = node as usize;
+    'nodes: loop {
         if len >= out.len() {
             w.overflow = true;
             break;
         }
-        out[len] = model.node_vertex[n];
+        out[len] = vertex[r].get();
         len += 1;
-        let end = model.node_arcs[n + 1] as usize;
-        let mut a = start;
-        while a < end && model.arc_res[a] < lod {
-            w.from = w.from.max(model.arc_res[a] + 1);
-            a += 1;
-        }
-        if a == end {
+        // The node's arcs are this record and the ones its MORE bits chain.
+        let c = loop {
+            let c = code[r];
+            if c == NO_ARC {
+                break 'nodes;
+            }
+            let l = label[r].get();
+            if l >= rel {
+                w.to = w.to.min(birth + l);
+                break c;
+            }
+            w.from = w.from.max(birth + l + 1);
+            if c & MORE == 0 {
+                break 'nodes;
+            }
+            r += 1;
+        };
+        let distance = c & DISTANCE;
+        if distance == 0 {
             break;
         }
-        w.to = w.to.min(model.arc_res[a]);
-        let t = model.arc_target[a];
-        if t == END {
-            break;
-        }
-        if t & RESTART != 0 {
+        if c & BREAK != 0 {
             if len >= out.len() {
                 w.overflow = true;
                 break;
@@ -355,19 +373,19 @@ fn walk(model: &MtsModel, s: usize, lod: u32, out: &mut [u32]) -> Walk {
             out[len] = RESTART_U32;
             len += 1;
         }
-        // Usually the next node is the next one stored, whose arcs start
-        // where this node's end: on that (predicted) branch the next
-        // iteration's loads do not wait for the target just loaded, which
-        // takes a load off the walk's dependency chain.
-        let next = (t & NODE_MASK) as usize;
-        if next == n + 1 {
-            n = next;
-            start = end;
+        r = if distance == FAR {
+            far_target(model, r)
         } else {
-            n = next;
-            start = model.node_arcs[n] as usize;
-        }
+            r + usize::from(distance)
+        };
     }
     w.len = len as u32;
     w
+}
+
+/// The target of far arc `r` (the table is checked to hold every far arc).
+#[cold]
+fn far_target(model: &MtsModel, r: usize) -> usize {
+    let i = model.far.partition_point(|&(at, _)| (at as usize) < r);
+    model.far[i].1 as usize
 }

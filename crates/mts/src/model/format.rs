@@ -1,13 +1,14 @@
 //! The `.mts` file: a versioned little-endian binary format.
 //!
-//! **Decision: the file stores what the graphs are built from, not the
-//! graphs.** The graphs are a deterministic function of the LoD-0 strips,
-//! the contraction sequence and the build options ([`super::build`]), and
-//! building them costs O(strip changes), about the time of reading them.
-//! Stored explicitly (the paper's way) the bunny's graphs with their bands
-//! take about 20 bytes per triangle on top of the vertices; stored as their
-//! inputs the whole file is under the raw mesh size. So the loader
-//! validates every count, index and label of the inputs and then builds.
+//! **Decision (version 3): the file holds the model ready to walk, and the
+//! recipe beside it.** Versions 1 and 2 stored only what the graphs are
+//! built from (the LoD-0 strips, the contraction sequence, the build
+//! options), so loading meant building again: about half a second for the
+//! bunny. Version 3 adds the `MODL` section, the compact records of
+//! [`super::records`] as they lie in memory, so loading is one pass over
+//! the bytes plus [`MtsModel::validate`]; the recipe stays for `mts verify`
+//! and for building again, and is decoded but not built. Files of versions
+//! 1 and 2 still load (built again).
 //!
 //! Layout (all integers little-endian):
 //!
@@ -16,8 +17,10 @@
 //! section  tag [u8; 4] | payload length u64 | payload
 //! ```
 //!
-//! The checksum is FNV-1a (64 bit) of every byte after the header. Sections,
-//! in this order:
+//! The checksum is of every byte after the header: FNV-1a (64 bit) in
+//! versions 1 and 2, its four-lane word form
+//! ([`crate::checksum::fnv1a64_words`]) in version 3. Sections, in this
+//! order:
 //! - `META`: varints vertex count, appended vertex count, run count, strip
 //!   index count, step count; then band slack (f64), the band stripifier's
 //!   options (patches u8, min patch quads varint, two swap penalties as f32
@@ -29,8 +32,8 @@
 //! - `STEP`: per contraction: removed (varint), kept (varint), error (f32).
 //!
 //! Version 2 adds two sections after these, and is written only for a
-//! model that needs them (a mesh with properties or seams), so files of
-//! positions only stay version 1, byte for byte; both versions load:
+//! model that needs them (a mesh with properties or seams); version 3
+//! always has them, then `MODL`:
 //! - `PROP`: flags u8 (1 normals, 2 texture coordinates, 4 colours, 8
 //!   position ids, 16 texture), then per input vertex `3 × f32` normals,
 //!   `2 × f32` UVs, `4 × f32` colours, a varint position id, as flagged;
@@ -39,10 +42,18 @@
 //!   image bytes (each with a varint length).
 //! - `CMPN`: per step, its number of companion moves (varint), then each
 //!   move's removed and kept vertex (varints).
+//! - `MODL`: varints strips, bands, beginnings, records, far arcs; the
+//!   vertex and label widths (u8 each, 2 or 4); then as `u32` arrays the
+//!   bands' first LoDs, the band → strip offsets, the strip → record and
+//!   strip → beginning offsets, the slot sizes, the beginnings' records and
+//!   labels; the records' vertices and labels (at their widths) and codes
+//!   (u8); the far arcs (record, target as `u32` pairs); the LoD → triangle
+//!   count table (`u32`, one more entry than steps).
 //!
 //! Every count is checked against the bytes that must hold it before
 //! anything is allocated, so a corrupt file costs at most its own size.
 
+use super::records::Narrow;
 use super::{build, BuildOptions, MtsModel};
 use crate::error::{Error, Place, Result};
 use crate::mesh::Mesh;
@@ -53,17 +64,42 @@ use std::path::{Path, PathBuf};
 
 /// The file's first bytes.
 pub const MAGIC: &[u8; 8] = b"MTSMODEL";
-/// The newest version this crate writes and reads (it reads 1 too).
-pub const VERSION: u32 = 2;
+/// The version this crate writes; it reads 1 and 2 too.
+pub const VERSION: u32 = 3;
 const HEADER_LEN: usize = 32;
-const TAGS: [&[u8; 4]; 6] = [b"META", b"POSI", b"STRP", b"STEP", b"PROP", b"CMPN"];
+const TAGS: [&[u8; 4]; 7] = [
+    b"META", b"POSI", b"STRP", b"STEP", b"PROP", b"CMPN", b"MODL",
+];
 /// Sections of a version-1 file.
 const V1_SECTIONS: usize = 4;
 
+/// Sections of a file of `version`.
+fn section_count(version: u32) -> usize {
+    match version {
+        1 => V1_SECTIONS,
+        2 => 6,
+        _ => TAGS.len(),
+    }
+}
+
 impl MtsModel {
-    /// The model as `.mts` bytes.
+    /// The model as `.mts` bytes, ready to walk (version 3): what
+    /// [`MtsModel::save`] writes.
     #[must_use]
     pub fn to_bytes(&self) -> Vec<u8> {
+        self.encode(true)
+    }
+
+    /// The model as `.mts` bytes of its recipe only (version 1, or 2 for a
+    /// mesh with properties or seams): about a seventh of
+    /// [`MtsModel::to_bytes`] on the bunny, but loading builds the graphs
+    /// again (hundreds of milliseconds instead of a few).
+    #[must_use]
+    pub fn to_recipe_bytes(&self) -> Vec<u8> {
+        self.encode(false)
+    }
+
+    fn encode(&self, ready: bool) -> Vec<u8> {
         let r = &self.recipe;
         let c = &r.collapses;
         let mut meta = Vec::new();
@@ -111,13 +147,18 @@ impl MtsModel {
         }
 
         let mut payloads = vec![meta, posi, strp, step];
-        let version = if self.properties.is_empty() && !c.has_companions() {
+        let version = if ready {
+            VERSION
+        } else if self.properties.is_empty() && !c.has_companions() {
             1
         } else {
+            2
+        };
+        if version > 1 {
             payloads.push(properties_payload(&self.properties));
             let mut cmpn = Vec::new();
             for i in 0..c.max_lod() {
-                let moves: Vec<(u32, u32)> = c.moves(i).skip(1).collect();
+                let moves: Vec<(u32, u32)> = c.companions(i).collect();
                 put_varint(&mut cmpn, moves.len() as u64);
                 for (r, k) in moves {
                     put_varint(&mut cmpn, u64::from(r));
@@ -125,8 +166,10 @@ impl MtsModel {
                 }
             }
             payloads.push(cmpn);
-            2
-        };
+        }
+        if version > 2 {
+            payloads.push(self.model_payload());
+        }
         let mut body = Vec::new();
         let sections = payloads.len();
         for (tag, payload) in TAGS.iter().zip(payloads) {
@@ -136,15 +179,67 @@ impl MtsModel {
         }
         let mut out = Vec::with_capacity(HEADER_LEN + body.len());
         out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&(version as u32).to_le_bytes());
+        out.extend_from_slice(&version.to_le_bytes());
         out.extend_from_slice(&(sections as u32).to_le_bytes());
         out.extend_from_slice(&((HEADER_LEN + body.len()) as u64).to_le_bytes());
-        out.extend_from_slice(&crate::checksum::fnv1a64(&body).to_le_bytes());
+        let sum = if ready {
+            crate::checksum::fnv1a64_words(&body)
+        } else {
+            crate::checksum::fnv1a64(&body)
+        };
+        out.extend_from_slice(&sum.to_le_bytes());
         out.extend_from_slice(&body);
         out
     }
 
-    /// Writes the model to `path`.
+    /// The `MODL` section.
+    fn model_payload(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.stats().memory_bytes);
+        for n in [
+            self.strip_count(),
+            self.band_count(),
+            self.begin_node.len(),
+            self.rec_code.len(),
+            self.far.len(),
+        ] {
+            put_varint(&mut out, n as u64);
+        }
+        out.push(self.rec_vertex.width() as u8);
+        out.push(self.rec_label.width() as u8);
+        let words = |out: &mut Vec<u8>, v: &[u32]| {
+            for x in v {
+                out.extend_from_slice(&x.to_le_bytes());
+            }
+        };
+        for v in [
+            &self.band_lod,
+            &self.band_strips,
+            &self.strip_records,
+            &self.strip_begins,
+            &self.slot_size,
+            &self.begin_node,
+            &self.begin_res,
+        ] {
+            words(&mut out, v);
+        }
+        for n in [&self.rec_vertex, &self.rec_label] {
+            match n {
+                Narrow::U16(v) => v
+                    .iter()
+                    .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
+                Narrow::U32(v) => words(&mut out, v),
+            }
+        }
+        out.extend_from_slice(&self.rec_code);
+        for &(r, t) in &self.far {
+            words(&mut out, &[r, t]);
+        }
+        words(&mut out, self.recipe.collapses.triangle_counts());
+        out
+    }
+
+    /// Writes the model to `path`, ready to walk (see
+    /// [`MtsModel::to_bytes`]).
     ///
     /// # Errors
     /// [`Error::Io`] if the file cannot be written.
@@ -173,22 +268,30 @@ impl MtsModel {
     /// naming the byte offset and section of the first problem otherwise
     /// (truncation, checksum, counts, indices, labels).
     pub fn from_bytes(bytes: &[u8], file: &Path) -> Result<MtsModel> {
-        let recipe = parse(bytes, file)?;
-        let model = build(
-            &recipe.mesh,
-            &recipe.strips,
-            &recipe.collapses,
-            &recipe.options,
-        );
-        debug_assert_eq!(model.properties, recipe.mesh.properties);
-        model.validate().map_err(|e| {
-            parse_error(
-                file,
-                0,
-                "model",
-                format!("built model is invalid: {}", e.message),
-            )
-        })?;
+        let parsed = parse(bytes, file)?;
+        let Some(mut modl) = parsed.modl.clone() else {
+            let model = build(
+                &parsed.mesh,
+                &parsed.strips,
+                &parsed.collapses,
+                &parsed.options,
+            );
+            debug_assert_eq!(model.properties, parsed.mesh.properties);
+            model.validate().map_err(|e| {
+                parse_error(
+                    file,
+                    0,
+                    "model",
+                    format!("built model is invalid: {}", e.message),
+                )
+            })?;
+            return Ok(model);
+        };
+        let at = modl.base;
+        let model = read_model(&mut modl, parsed)?;
+        model
+            .validate()
+            .map_err(|e| parse_error(file, at, "MODL", e.message))?;
         Ok(model)
     }
 }
@@ -203,12 +306,24 @@ pub fn seal(bytes: &mut [u8]) {
     }
     let len = bytes.len() as u64;
     bytes[16..24].copy_from_slice(&len.to_le_bytes());
-    let sum = crate::checksum::fnv1a64(&bytes[HEADER_LEN..]);
+    let version = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+    let body = &bytes[HEADER_LEN..];
+    let sum = if version < 3 {
+        crate::checksum::fnv1a64(body)
+    } else {
+        crate::checksum::fnv1a64_words(body)
+    };
     bytes[24..32].copy_from_slice(&sum.to_le_bytes());
 }
 
 /// What a file holds, validated.
-struct Parsed {
+struct Parsed<'a> {
+    /// Every vertex, appended ones too.
+    positions: Vec<Vec3>,
+    /// Version 3's ready model, not yet read.
+    modl: Option<Reader<'a>>,
+    /// The input vertices with their properties, and (before version 3)
+    /// the strips' triangles to build from.
     mesh: Mesh,
     strips: Strips,
     collapses: Collapses,
@@ -228,6 +343,7 @@ fn parse_error(file: &Path, byte: usize, element: &str, message: String) -> Erro
 }
 
 /// A bounds-checked little-endian reader over one section.
+#[derive(Clone)]
 struct Reader<'a> {
     bytes: &'a [u8],
     pos: usize,
@@ -238,6 +354,8 @@ struct Reader<'a> {
 }
 
 impl Reader<'_> {
+    #[cold]
+    #[inline(never)]
     fn error(&self, message: impl Into<String>) -> Error {
         parse_error(
             &self.file,
@@ -251,6 +369,7 @@ impl Reader<'_> {
         self.bytes.len() - self.pos
     }
 
+    #[inline]
     fn take(&mut self, n: usize) -> Result<&[u8]> {
         if self.remaining() < n {
             return Err(self.error(format!(
@@ -263,10 +382,12 @@ impl Reader<'_> {
         Ok(s)
     }
 
+    #[inline]
     fn u8(&mut self) -> Result<u8> {
         Ok(self.take(1)?[0])
     }
 
+    #[inline]
     fn f32(&mut self) -> Result<f32> {
         let b = self.take(4)?;
         Ok(f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
@@ -278,7 +399,33 @@ impl Reader<'_> {
         Ok(f64::from_le_bytes(a))
     }
 
+    /// `n` little-endian `u32`s.
+    fn words(&mut self, n: usize) -> Result<Vec<u32>> {
+        let bytes = self.take(
+            n.checked_mul(4)
+                .ok_or_else(|| self.error("count overflows"))?,
+        )?;
+        Ok(bytes
+            .chunks_exact(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect())
+    }
+
+    #[inline]
     fn varint(&mut self) -> Result<u64> {
+        // Fast path: a one- or two-byte varint with its bytes present.
+        if let [b0, rest @ ..] = &self.bytes[self.pos..] {
+            if b0 & 0x80 == 0 {
+                self.pos += 1;
+                return Ok(u64::from(*b0));
+            }
+            if let Some(&b1) = rest.first() {
+                if b1 & 0x80 == 0 {
+                    self.pos += 2;
+                    return Ok(u64::from(b0 & 0x7f) | u64::from(b1) << 7);
+                }
+            }
+        }
         let mut v = 0u64;
         for shift in (0..64).step_by(7) {
             let b = self.u8()?;
@@ -315,7 +462,7 @@ impl Reader<'_> {
     }
 }
 
-fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
+fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
     if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
         return Err(Error::UnknownFormat {
             file: file.to_owned(),
@@ -347,11 +494,7 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         });
     }
     let header = |byte, m: String| parse_error(file, byte, "header", m);
-    let section_count = if version == 1 {
-        V1_SECTIONS
-    } else {
-        TAGS.len()
-    };
+    let section_count = section_count(version);
     if u32_at(12) as usize != section_count {
         return Err(header(
             12,
@@ -372,7 +515,11 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         ));
     }
     let body = &bytes[HEADER_LEN..];
-    let sum = crate::checksum::fnv1a64(body);
+    let sum = if version < 3 {
+        crate::checksum::fnv1a64(body)
+    } else {
+        crate::checksum::fnv1a64_words(body)
+    };
     if u64_at(24) != sum {
         return Err(header(
             24,
@@ -420,7 +567,7 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
     }
     top.finish()?;
     let mut extra = sections.split_off(V1_SECTIONS).into_iter();
-    let (prop, cmpn) = (extra.next(), extra.next());
+    let (prop, cmpn, modl) = (extra.next(), extra.next(), extra.next());
     let [mut meta, mut posi, mut strp, mut step]: [Reader; 4] = sections
         .try_into()
         .map_err(|_| parse_error(file, HEADER_LEN, "section table", "section count".into()))?;
@@ -533,15 +680,20 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         vertices as u32,
     )
     .map_err(|e| strp.error(e.to_string()))?;
+    // A ready model needs no mesh to build from.
     let mut mesh = Mesh {
         positions: positions[..vertices].to_vec(),
-        triangles: strips.triangles(),
+        triangles: if modl.is_some() {
+            Vec::new()
+        } else {
+            strips.triangles()
+        },
         properties: Default::default(),
     };
     if let Some(mut prop) = prop {
         mesh.properties = read_properties(&mut prop, &mesh.positions)?;
     }
-    if mesh.triangles.is_empty() {
+    if strips.triangle_count() == 0 {
         return Err(strp.error("the strips draw no triangle"));
     }
 
@@ -590,10 +742,18 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
         None => Vec::new(),
     };
     let appended_positions = positions[vertices..].to_vec();
-    let counts = replay_counts(&mesh, &list, optimal, &companions);
+    // Version 3 stores the triangle counts with the model (read and
+    // checked by `read_model`); earlier versions replay them.
+    let counts = if let Some(m) = &modl {
+        table_at_end(m, list.len() + 1, strips.triangle_count() as u32)?
+    } else {
+        replay_counts(&mesh, &list, optimal, &companions)
+    };
     let collapses =
         Collapses::with_companions(vertices, list, counts, appended_positions, companions);
     Ok(Parsed {
+        positions,
+        modl,
         mesh,
         strips,
         collapses,
@@ -610,7 +770,111 @@ fn parse(bytes: &[u8], file: &Path) -> Result<Parsed> {
     })
 }
 
-const SECTION_NAMES: [&str; 6] = ["META", "POSI", "STRP", "STEP", "PROP", "CMPN"];
+const SECTION_NAMES: [&str; 7] = ["META", "POSI", "STRP", "STEP", "PROP", "CMPN", "MODL"];
+
+/// Reads the `MODL` section into the model `parsed` describes. Every count
+/// is bounded by the bytes left before anything is allocated; the
+/// structure is checked afterwards by [`MtsModel::validate`].
+fn read_model(r: &mut Reader<'_>, parsed: Parsed<'_>) -> Result<MtsModel> {
+    let max_lod = parsed.collapses.max_lod();
+    let left = r.remaining() as u64;
+    let strips = r.count("strip count", left / 12)?;
+    let bands = r.count("band count", left / 8)?;
+    let begins = r.count("beginning count", left / 8)?;
+    let records = r.count("record count", left / 3)?;
+    let far = r.count("far arc count", left / 8)?;
+    let mut width = |what: &str| -> Result<usize> {
+        match r.u8()? {
+            w @ (2 | 4) => Ok(usize::from(w)),
+            w => {
+                r.pos -= 1;
+                Err(r.error(format!("{what} width {w}, not 2 or 4")))
+            }
+        }
+    };
+    let (vertex_width, label_width) = (width("vertex")?, width("label")?);
+    let needed = 4 * (2 * bands + 1 + 3 * (strips + 1) + 2 * begins + 2 * far + max_lod + 1) as u64
+        - 4
+        + ((vertex_width + label_width + 1) * records) as u64;
+    if needed != r.remaining() as u64 {
+        return Err(r.error(format!(
+            "{} bytes for {strips} strips, {bands} bands, {begins} beginnings, {records} records, \
+             {far} far arcs and {} LoDs; {needed} expected",
+            r.remaining(),
+            max_lod + 1
+        )));
+    }
+    let band_lod = r.words(bands)?;
+    let band_strips = r.words(bands + 1)?;
+    let strip_records = r.words(strips + 1)?;
+    let strip_begins = r.words(strips + 1)?;
+    let slot_size = r.words(strips)?;
+    let begin_node = r.words(begins)?;
+    let begin_res = r.words(begins)?;
+    let mut narrow = |width: usize| -> Result<Narrow> {
+        Ok(if width == 2 {
+            Narrow::U16(
+                r.take(2 * records)?
+                    .chunks_exact(2)
+                    .map(|b| u16::from_le_bytes([b[0], b[1]]))
+                    .collect(),
+            )
+        } else {
+            Narrow::U32(r.words(records)?)
+        })
+    };
+    let rec_vertex = narrow(vertex_width)?;
+    let rec_label = narrow(label_width)?;
+    let rec_code = r.take(records)?.to_vec();
+    let far_words = r.words(2 * far)?;
+    let far = far_words.chunks_exact(2).map(|p| (p[0], p[1])).collect();
+    // The LoD → triangle table, read by `parse` already.
+    r.take(4 * (max_lod + 1))?;
+    r.finish()?;
+    Ok(MtsModel {
+        positions: parsed.positions,
+        properties: parsed.mesh.properties,
+        strip_records,
+        strip_begins,
+        begin_node,
+        begin_res,
+        rec_vertex,
+        rec_label,
+        rec_code,
+        far,
+        slot_size,
+        band_lod,
+        band_strips,
+        recipe: super::Recipe {
+            strips: parsed.strips,
+            collapses: parsed.collapses,
+            options: parsed.options,
+        },
+    })
+}
+
+/// The LoD → triangle count table that ends the `MODL` section in `r`
+/// (`lods` entries), checked to start at the strips' `triangles` and
+/// never grow.
+fn table_at_end(r: &Reader<'_>, lods: usize, triangles: u32) -> Result<Vec<u32>> {
+    let mut t = r.clone();
+    let Some(start) = t.bytes.len().checked_sub(4 * lods) else {
+        return Err(t.error(format!(
+            "{} bytes cannot end with a table of {lods} LoDs",
+            t.bytes.len()
+        )));
+    };
+    t.pos = start;
+    let counts = t.words(lods)?;
+    if counts[0] != triangles || counts.windows(2).any(|w| w[1] > w[0]) {
+        t.pos = start;
+        return Err(t.error(format!(
+            "the LoD → triangle table does not start at the strips' {triangles} triangles \
+             and fall"
+        )));
+    }
+    Ok(counts)
+}
 
 /// The `PROP` section of `p`.
 fn properties_payload(p: &crate::mesh::Properties) -> Vec<u8> {

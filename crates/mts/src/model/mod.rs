@@ -1,21 +1,21 @@
 //! The MTS model: one labelled graph per triangle strip (section 3.1 of the
-//! MTS paper, "Data structure"), stored as flat arrays.
+//! MTS paper, "Data structure"), stored as flat arrays of compact records.
 //!
-//! Strip `s` owns the nodes `strip_nodes[s]..strip_nodes[s + 1]` and the
-//! beginnings `strip_begins[s]..strip_begins[s + 1]`. A node (the paper's
-//! `ColumnNode`) names one vertex; its arcs (`RowNode`s) are
-//! `node_arcs[n]..node_arcs[n + 1]`, each with a target and a label `res`:
-//! the arc may be walked at every LoD up to and including `res`. A node's
-//! arcs are valid over consecutive, disjoint LoD intervals in the order
-//! they are stored, so at LoD `L` the valid arc is the first whose label is
-//! at least `L` (the paper's Fig. 5 prints the comparison the wrong way
-//! round; its text, "arcs having a label greater or equal to the requested
-//! LoD", is what is meant).
+//! Strip `s` owns the records `strip_records[s]..strip_records[s + 1]` and
+//! the beginnings `strip_begins[s]..strip_begins[s + 1]`. A node (the
+//! paper's `ColumnNode`) names one vertex; its arcs (`RowNode`s) are
+//! consecutive records ([`records`] gives the layout), each with a target
+//! and a label `res`: the arc may be walked at every LoD up to and
+//! including `res`. A node's arcs are valid over consecutive, disjoint LoD
+//! intervals in the order they are stored, so at LoD `L` the valid arc is
+//! the first whose label is at least `L` (the paper's Fig. 5 prints the
+//! comparison the wrong way round; its text, "arcs having a label greater
+//! or equal to the requested LoD", is what is meant).
 //!
-//! The paper's special nodes become arc targets: an arc to [`END`] ends the
-//! strip (−3); an arc whose target carries [`RESTART`] ends the current run
-//! and starts the next one at the target (−2, and −1 when the target names
-//! the same vertex: a node per occurrence needs no separate marker for it).
+//! The paper's special nodes become arc targets: an arc to the end ends the
+//! strip (−3); an arc with a break ends the current run and starts the next
+//! one at the target (−2, and −1 when the target names the same vertex: a
+//! node per occurrence needs no separate marker for it).
 //!
 //! Decisions where the paper leaves room (see `build.rs` for the
 //! construction and its proofs):
@@ -23,14 +23,15 @@
 //!   a vertex that a strip visits twice (a swap does that) gets two nodes,
 //!   so every node has at most one valid arc at any LoD and the walk never
 //!   has to choose between two arcs with the same label.
-//! - **Arcs go forward**: nodes are numbered in strip order, so every
-//!   target is a later node. The walk therefore ends after at most as many
-//!   steps as the strip has nodes, even on a corrupt model.
+//! - **Arcs go forward**: nodes are stored in strip order, so every target
+//!   is a later record. The walk therefore ends after at most as many
+//!   steps as the strip has records, even on a corrupt model.
 
 mod build;
 mod extract;
 pub mod format;
 mod pipeline;
+pub(crate) mod records;
 pub mod sequence;
 mod verify;
 
@@ -43,6 +44,7 @@ pub use pipeline::{build_from_mesh, PipelineOptions, PipelineTimings};
 pub use verify::{spread_lods, verify, VerifyReport};
 
 use glam::Vec3;
+use records::{Narrow, Word};
 
 /// Arc target meaning "the strip ends here" (the paper's −3).
 pub const END: u32 = u32::MAX;
@@ -58,11 +60,12 @@ pub const NODE_MASK: u32 = RESTART - 1;
 ///
 /// Invariants (checked by [`MtsModel::validate`], which the loader runs):
 /// offsets are non-decreasing and in range; every node's vertex is below the
-/// vertex count; every arc target is [`END`] or a later node of the same
-/// strip (optionally with [`RESTART`]); labels are at most `max_lod` and
-/// strictly increasing along a node's arcs and along a strip's beginnings,
-/// and a strip's last beginning has label `max_lod`. The LoD → triangle
-/// table is the contraction sequence's.
+/// vertex count; every arc target is the end or a later node of the same
+/// strip; labels are at most `max_lod` and strictly increasing along a
+/// node's arcs and along a strip's beginnings, and a strip's last beginning
+/// has label `max_lod`; a strip's slot size is the length of its walk at
+/// its band's first LoD.
+/// The LoD → triangle table is the contraction sequence's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MtsModel {
     pub(crate) positions: Vec<Vec3>,
@@ -70,24 +73,31 @@ pub struct MtsModel {
     /// position ids); empty for a mesh of positions only. A LoD draws
     /// input vertices (endpoint placement), so they serve every LoD.
     pub(crate) properties: crate::mesh::Properties,
-    pub(crate) strip_nodes: Vec<u32>,
+    /// Per strip, its first record (one more entry than strips).
+    pub(crate) strip_records: Vec<u32>,
     pub(crate) strip_begins: Vec<u32>,
-    /// Per beginning: the first node (global index) or [`END`] for "the
-    /// strip draws nothing at these LoDs".
+    /// Per beginning: the first node's record or [`END`] for "the strip
+    /// draws nothing at these LoDs".
     pub(crate) begin_node: Vec<u32>,
     pub(crate) begin_res: Vec<u32>,
-    pub(crate) node_vertex: Vec<u32>,
-    pub(crate) node_arcs: Vec<u32>,
-    /// Per arc: target node (global index) with optional [`RESTART`], or
-    /// [`END`].
-    pub(crate) arc_target: Vec<u32>,
-    pub(crate) arc_res: Vec<u32>,
+    /// Per record ([`records`]): the node's vertex, the arc's label
+    /// relative to the band's first LoD, and its code.
+    pub(crate) rec_vertex: records::Narrow,
+    pub(crate) rec_label: records::Narrow,
+    pub(crate) rec_code: Vec<u8>,
+    /// (record, target record) of the arcs that jump [`records::FAR`]
+    /// records or more, by record.
+    pub(crate) far: Vec<(u32, u32)>,
+    /// Per strip, the indices its sequence takes at its band's first LoD
+    /// (the longest it gets, see `build.rs`, "Monotone"): the extractor's
+    /// slot sizes, so that it need not walk every strip to start.
+    pub(crate) slot_size: Vec<u32>,
     /// First LoD of each band, and each band's strips
     /// (`band_strips[b]..band_strips[b + 1]`).
     pub(crate) band_lod: Vec<u32>,
     pub(crate) band_strips: Vec<u32>,
-    /// What the model was built from; the `.mts` file stores this and the
-    /// loader builds the graphs again (see [`format`]).
+    /// What the model was built from (the `.mts` file stores it beside
+    /// the graphs, for `verify` and for building again; see [`format`]).
     pub(crate) recipe: Recipe,
 }
 
@@ -118,7 +128,7 @@ impl MtsModel {
     /// Number of strips.
     #[must_use]
     pub fn strip_count(&self) -> usize {
-        self.strip_nodes.len().saturating_sub(1)
+        self.strip_records.len().saturating_sub(1)
     }
 
     /// Number of contractions; LoDs run from 0 to `max_lod()`.
@@ -226,22 +236,34 @@ impl MtsModel {
     /// Node, arc and byte counts.
     #[must_use]
     pub fn stats(&self) -> ModelStats {
-        let words = self.strip_nodes.len()
+        let records = self.rec_code.len();
+        let no_arc = self
+            .rec_code
+            .iter()
+            .filter(|&&c| c == records::NO_ARC)
+            .count();
+        let later = self
+            .rec_code
+            .iter()
+            .filter(|&&c| c & records::MORE != 0)
+            .count();
+        let words = self.strip_records.len()
             + self.strip_begins.len()
             + self.begin_node.len()
             + self.begin_res.len()
-            + self.node_vertex.len()
-            + self.node_arcs.len()
-            + self.arc_target.len()
-            + self.arc_res.len()
+            + 2 * self.far.len()
+            + self.slot_size.len()
             + self.band_lod.len()
             + self.band_strips.len();
         ModelStats {
             strips: self.strip_count(),
-            nodes: self.node_vertex.len(),
-            arcs: self.arc_target.len(),
+            nodes: records - later,
+            arcs: records - no_arc,
             begins: self.begin_node.len(),
             memory_bytes: 4 * words
+                + self.rec_vertex.bytes()
+                + self.rec_label.bytes()
+                + records
                 + 12 * self.positions.len()
                 + self.properties.bytes_per_vertex() * self.recipe.collapses.vertex_count()
                 + 4 * self.properties.position_ids.len(),
@@ -266,9 +288,26 @@ impl MtsModel {
         12 * self.recipe.collapses.vertex_count() + 6 * self.triangle_count(0)
     }
 
-    /// The nodes of strip `s`.
-    pub(crate) fn nodes_of(&self, s: usize) -> std::ops::Range<usize> {
-        self.strip_nodes[s] as usize..self.strip_nodes[s + 1] as usize
+    /// The records of strip `s`.
+    pub(crate) fn records_of(&self, s: usize) -> std::ops::Range<usize> {
+        self.strip_records[s] as usize..self.strip_records[s + 1] as usize
+    }
+
+    /// Whether record `r` of a strip whose records start at `first` starts
+    /// a node (is not a later arc of the node before it).
+    pub(crate) fn starts_node(&self, r: usize, first: usize) -> bool {
+        r == first || self.rec_code[r - 1] & records::MORE == 0
+    }
+
+    /// The first LoD of each strip's band.
+    pub(crate) fn strip_births(&self) -> Vec<u32> {
+        let mut births = vec![0; self.strip_count()];
+        for b in 0..self.band_count() {
+            for s in self.band_strips(b) {
+                births[s] = self.band_lod[b];
+            }
+        }
+        births
     }
 
     /// The beginnings of strip `s`.
@@ -289,22 +328,23 @@ impl MtsModel {
 
     fn check_parts(&self) -> Result<(), String> {
         let max_lod = self.max_lod() as u32;
-        check_offsets("strip node", &self.strip_nodes, self.node_vertex.len())?;
+        let records = self.rec_code.len();
+        check_offsets("strip record", &self.strip_records, records)?;
         check_offsets("strip beginning", &self.strip_begins, self.begin_node.len())?;
-        check_offsets("node arc", &self.node_arcs, self.arc_target.len())?;
-        if self.strip_nodes.len() != self.strip_begins.len() {
-            return Err("node and beginning offsets disagree on the strip count".into());
+        if self.strip_records.len() != self.strip_begins.len() {
+            return Err("record and beginning offsets disagree on the strip count".into());
         }
-        if self.node_arcs.len() != self.node_vertex.len() + 1 {
-            return Err("arc offsets do not match the node count".into());
+        if self.rec_vertex.len() != records || self.rec_label.len() != records {
+            return Err("record arrays differ in length".into());
         }
-        if self.begin_res.len() != self.begin_node.len()
-            || self.arc_res.len() != self.arc_target.len()
-        {
+        if self.begin_res.len() != self.begin_node.len() {
             return Err("label arrays do not match their targets".into());
         }
-        if self.node_vertex.len() >= NODE_MASK as usize {
-            return Err("too many nodes".into());
+        if self.slot_size.len() != self.strip_count() {
+            return Err("slot sizes do not match the strip count".into());
+        }
+        if records >= NODE_MASK as usize {
+            return Err("too many records".into());
         }
         if self.band_lod.first() != Some(&0) || self.band_lod.windows(2).any(|w| w[1] <= w[0]) {
             return Err("band LoDs do not start at 0 and increase".into());
@@ -316,30 +356,82 @@ impl MtsModel {
         if self.band_strips.len() != self.band_lod.len() + 1 {
             return Err("band tables disagree".into());
         }
-        let vertices = self.positions.len() as u32;
-        if let Some(n) = self.node_vertex.iter().position(|&v| v >= vertices) {
-            return Err(format!(
-                "node {n} names vertex {} of {vertices}",
-                self.node_vertex[n]
-            ));
-        }
         if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("vertex {v} is not finite"));
         }
-        for s in 0..self.strip_count() {
-            let nodes = self.nodes_of(s);
-            let in_strip = |t: u32| t == END || (nodes.contains(&((t & NODE_MASK) as usize)));
+        if self.far.windows(2).any(|w| w[1].0 <= w[0].0) {
+            return Err("far arcs are not sorted by record".into());
+        }
+        // The strips, in chunks of about equal records checked on all
+        // cores (the loader's main cost); the first error in strip order
+        // is reported.
+        let births = self.strip_births();
+        let threads = std::thread::available_parallelism()
+            .map_or(1, std::num::NonZeroUsize::get)
+            .min(1 + records / 200_000);
+        let mut cuts = vec![0];
+        for t in 1..threads {
+            let at = (records * t / threads) as u32;
+            cuts.push(
+                self.strip_records
+                    .partition_point(|&r| r < at)
+                    .min(self.strip_count()),
+            );
+        }
+        cuts.push(self.strip_count());
+        let results: Vec<Result<usize, String>> = if threads == 1 {
+            vec![self.check_strips(0..self.strip_count(), &births)]
+        } else {
+            std::thread::scope(|scope| {
+                let handles: Vec<_> = cuts
+                    .windows(2)
+                    .map(|w| {
+                        let (range, births) = (w[0]..w[1], &births);
+                        scope.spawn(move || self.check_strips(range, births))
+                    })
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                    .collect()
+            })
+        };
+        let mut far_arcs = 0;
+        for r in results {
+            far_arcs += r?;
+        }
+        if far_arcs != self.far.len() {
+            return Err("the far table names a record whose arc is not far".into());
+        }
+        Ok(())
+    }
+
+    /// Checks strips `strips` (beginnings, records, slot sizes); returns
+    /// how many far arcs they hold.
+    fn check_strips(
+        &self,
+        strips: std::ops::Range<usize>,
+        births: &[u32],
+    ) -> Result<usize, String> {
+        let max_lod = self.max_lod() as u32;
+        let vertices = self.positions.len() as u32;
+        let first_record = self.strip_records[strips.start];
+        let far_start = self.far.partition_point(|&(r, _)| r < first_record);
+        let mut far = self.far[far_start..].iter();
+        let mut scratch = Vec::new();
+        for s in strips {
+            let recs = self.records_of(s);
+            let (first, birth) = (recs.start, births[s]);
+            let node_in_strip = |t: usize| recs.contains(&t) && self.starts_node(t, first);
             let begins = self.begins_of(s);
             if begins.is_empty() {
                 return Err(format!("strip {s} has no beginning"));
             }
             for b in begins.clone() {
-                if !in_strip(self.begin_node[b])
-                    || (self.begin_node[b] != END && self.begin_node[b] & RESTART != 0)
-                {
+                let n = self.begin_node[b];
+                if n != END && !node_in_strip(n as usize) {
                     return Err(format!(
-                        "strip {s} beginning {b} names node {:#x} outside the strip",
-                        self.begin_node[b]
+                        "strip {s} beginning {b} names record {n} outside the strip or inside a node"
                     ));
                 }
             }
@@ -350,20 +442,122 @@ impl MtsModel {
                     "strip {s}: last beginning is not labelled {max_lod}"
                 ));
             }
-            for n in nodes.clone() {
-                let arcs = self.node_arcs[n] as usize..self.node_arcs[n + 1] as usize;
-                for a in arcs.clone() {
-                    let t = self.arc_target[a];
-                    if !in_strip(t) || (t != END && (t & NODE_MASK) as usize <= n) {
-                        return Err(format!("strip {s} node {n} arc {a}: target {t:#x} is not a later node of the strip"));
-                    }
+            let ranges = Ranges {
+                recs: recs.clone(),
+                birth,
+                max_lod,
+                vertices,
+            };
+            match (&self.rec_vertex, &self.rec_label) {
+                (Narrow::U16(v), Narrow::U16(l)) => {
+                    check_records(&ranges, v, l, &self.rec_code, &mut far)
                 }
-                check_labels(&self.arc_res[arcs], max_lod)
-                    .map_err(|e| format!("strip {s} node {n}: {e}"))?;
+                (Narrow::U16(v), Narrow::U32(l)) => {
+                    check_records(&ranges, v, l, &self.rec_code, &mut far)
+                }
+                (Narrow::U32(v), Narrow::U16(l)) => {
+                    check_records(&ranges, v, l, &self.rec_code, &mut far)
+                }
+                (Narrow::U32(v), Narrow::U32(l)) => {
+                    check_records(&ranges, v, l, &self.rec_code, &mut far)
+                }
+            }
+            .map_err(|e| format!("strip {s} {e}"))?;
+            // The slot: the strip's walk at its band's first LoD has
+            // exactly the stored length (a longer one would be cut in its
+            // slot). A node emits its vertex and at most one break.
+            scratch.resize(2 * recs.len() + 1, 0);
+            let w = extract::walk(self, s, birth, birth, &mut scratch);
+            if w.len != self.slot_size[s] {
+                return Err(format!(
+                    "strip {s}: slot of {} indices, its walk at LoD {birth} takes {}",
+                    self.slot_size[s], w.len
+                ));
             }
         }
-        Ok(())
+        Ok(self.far.len() - far_start - far.len())
     }
+}
+
+/// What [`check_records`] checks one strip's records against.
+struct Ranges {
+    recs: std::ops::Range<usize>,
+    birth: u32,
+    max_lod: u32,
+    vertices: u32,
+}
+
+/// Checks one strip's records (see [`MtsModel`]'s invariants): vertices
+/// in range, arcs to later nodes of the strip, labels increasing along a
+/// node and within the LoDs; `far` is consumed in record order.
+fn check_records<V: Word, L: Word>(
+    strip: &Ranges,
+    vertex: &[V],
+    label: &[L],
+    code: &[u8],
+    far: &mut std::slice::Iter<'_, (u32, u32)>,
+) -> Result<(), String> {
+    use records::{BREAK, DISTANCE, FAR, MORE, NO_ARC};
+    let Ranges {
+        recs,
+        birth,
+        max_lod,
+        vertices,
+    } = strip;
+    let (first, end) = (recs.start, recs.end);
+    let (code, vertex, label) = (&code[..end], &vertex[..end], &label[..end]);
+    let label_limit = max_lod - birth;
+    let mut previous_label = 0;
+    // Whether record `r` starts a node: the record before has no MORE.
+    let mut node_start = true;
+    for r in first..end {
+        let c = code[r];
+        let l = label[r].get();
+        if node_start && vertex[r].get() >= *vertices {
+            return Err(format!(
+                "record {r} names vertex {} of {vertices}",
+                vertex[r].get()
+            ));
+        }
+        if c == NO_ARC {
+            if !node_start {
+                return Err(format!("record {r}: a node's later arc has no target"));
+            }
+            continue;
+        }
+        if l > label_limit {
+            return Err(format!(
+                "record {r}: label {l} past LoD {birth} is beyond LoD {max_lod}"
+            ));
+        }
+        if !node_start && l <= previous_label {
+            return Err(format!("record {r}: labels do not increase"));
+        }
+        previous_label = l;
+        let target = match c & DISTANCE {
+            0 if c & BREAK != 0 => {
+                return Err(format!("record {r}: a break to the strip's end"));
+            }
+            0 => None,
+            FAR => match far.next() {
+                Some(&(at, t)) if at as usize == r => Some(t as usize),
+                _ => return Err(format!("record {r}: far arc missing from the far table")),
+            },
+            d => Some(r + usize::from(d)),
+        };
+        if let Some(t) = target {
+            if t <= r || t >= end || code[t - 1] & MORE != 0 {
+                return Err(format!(
+                    "record {r}: target {t} is not a later node of the strip"
+                ));
+            }
+        }
+        node_start = c & MORE == 0;
+    }
+    if !node_start {
+        return Err(format!("record {}: the strip ends inside a node", end - 1));
+    }
+    Ok(())
 }
 
 fn check_offsets(what: &str, offsets: &[u32], len: usize) -> Result<(), String> {

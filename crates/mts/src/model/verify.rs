@@ -334,7 +334,10 @@ mod tests {
         let (mut model, mesh) = torus_model();
         // Node 5 names another vertex: the strips draw other triangles
         // from LoD 0 until that node leaves the strip.
-        model.node_vertex[5] = model.node_vertex[5].wrapping_add(1) % mesh.vertex_count() as u32;
+        let v = model.rec_vertex.get(5);
+        model
+            .rec_vertex
+            .set(5, (v + 1) % mesh.vertex_count() as u32);
         let report = verify(&model, &mesh, &spread_lods(model.max_lod(), Some(50)));
         assert_eq!(report.lods_checked, 50);
         assert!(report.mismatches >= 1);

@@ -235,6 +235,12 @@ impl Collapses {
         std::iter::once((s.removed, s.kept)).chain(companions.iter().copied())
     }
 
+    /// The companion pairs of step `i` (the other sides of the contracted
+    /// points at seams), as `(removed, kept)`.
+    pub(crate) fn companions(&self, i: usize) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.pairs(i).skip(1)
+    }
+
     /// Every vertex move of step `i` as `(from, to)`: `removed → kept` and
     /// its companions, or in optimal placement both vertices of each pair
     /// onto the vertex created for it. A LoD change applies all of them at
