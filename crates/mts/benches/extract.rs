@@ -4,7 +4,9 @@
 //! `mts::model::sequence`), with the coherence cache and from scratch, side
 //! by side in one group; plus LoD 0 from scratch and 1,000 consecutive LoDs
 //! (a step of one, the "linear sweep over all LoDs" case). Throughput is
-//! per LoD change.
+//! per LoD change. A second group: one-step changes near LoD 0 on the
+//! built-in 100K-triangle icosphere, whose LoD 0 is one long strip (the
+//! case coherence inside strips is for).
 
 mod common;
 
@@ -51,6 +53,35 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 for &lod in lods {
                     ex.set_lod_from_scratch(black_box(lod));
+                }
+            });
+        });
+    }
+    group.finish();
+
+    let ico: mts::Mesh = "icosphere:100k"
+        .parse::<mts::mesh::generate::Generated>()
+        .expect("valid name")
+        .build();
+    let (model, _, _) = build_from_mesh(&ico, &PipelineOptions::default(), &mut |_, _| {});
+    let mut ex = Extractor::new(&model);
+    let mut group = c.benchmark_group("extract/icosphere:100k");
+    group.sample_size(20);
+    // 1 -> 2 -> 1 -> ...: every call a one-step change near LoD 0.
+    let steps: Vec<usize> = (0..1000).map(|i| 1 + i % 2).collect();
+    group.throughput(Throughput::Elements(steps.len() as u64));
+    for (label, coherent) in [
+        ("one_step_near_lod0/coherent", true),
+        ("one_step_near_lod0/from_scratch", false),
+    ] {
+        group.bench_function(label, |b| {
+            b.iter(|| {
+                for &lod in &steps {
+                    if coherent {
+                        ex.set_lod(black_box(lod));
+                    } else {
+                        ex.set_lod_from_scratch(black_box(lod));
+                    }
                 }
             });
         });

@@ -159,6 +159,85 @@ proptest! {
     }
 }
 
+/// The next LoD of a random request sequence: mostly steps of a few LoDs
+/// either way (which re-walk strips from one of their segments), now and
+/// then a jump anywhere.
+fn next_request(x: &mut u64, current: usize, max_lod: usize) -> usize {
+    *x ^= *x << 13;
+    *x ^= *x >> 7;
+    *x ^= *x << 17;
+    let r = (*x >> 8) as usize;
+    if r % 5 == 0 {
+        r / 5 % (max_lod + 1)
+    } else {
+        (current + r / 5 % 4)
+            .saturating_sub(r / 20 % 4)
+            .min(max_lod)
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// Coherence inside strips: random requests give the same buffer as
+    /// walking every strip, and every changed index is in a dirty range.
+    #[test]
+    fn coherent_extraction_equals_scratch_on_random_requests(
+        m in random_surface(),
+        seed in 1u64..u64::MAX,
+    ) {
+        for options in [single_band(), BuildOptions::default()] {
+            let model = build(&m, &SimplifyOptions::default(), &options);
+            let max_lod = model.max_lod();
+            let mut coherent = Extractor::new(&model);
+            let mut scratch = Extractor::new(&model);
+            let mut before = coherent.buffer().to_vec();
+            let (mut x, mut lod) = (seed, 0);
+            for _ in 0..80 {
+                lod = next_request(&mut x, lod, max_lod);
+                coherent.set_lod(lod);
+                scratch.set_lod_from_scratch(lod);
+                prop_assert_eq!(coherent.buffer(), scratch.buffer(), "LoD {}", lod);
+                for (i, (a, b)) in before.iter().zip(coherent.buffer()).enumerate() {
+                    prop_assert!(
+                        a == b || coherent.dirty_ranges().iter().any(|r| r.contains(&i)),
+                        "LoD {}: index {} changed outside the dirty ranges", lod, i
+                    );
+                }
+                before.copy_from_slice(coherent.buffer());
+            }
+        }
+    }
+}
+
+/// One long strip (the built-in icosphere's LoD 0 is one): random requests
+/// near LoD 0 re-walk it from its segments and match the walk from scratch.
+#[test]
+fn a_long_strip_rewalks_from_its_segments() {
+    let mesh: Mesh = "icosphere:20k".parse::<Generated>().unwrap().build();
+    let m = build(&mesh, &SimplifyOptions::default(), &BuildOptions::default());
+    let mut coherent = Extractor::new(&m);
+    let mut scratch = Extractor::new(&m);
+    coherent.set_lod(0);
+    let (mut x, mut lod) = (0x2545_f491_4f6c_dd1du64, 0);
+    let (mut walked, mut whole) = (0, 0);
+    for _ in 0..500 {
+        lod = next_request(&mut x, lod, 200);
+        walked += coherent.set_lod(lod).indices_walked;
+        let all = scratch.set_lod_from_scratch(lod).indices_walked;
+        assert_eq!(coherent.buffer(), scratch.buffer(), "LoD {lod}");
+        let used: usize = (0..m.strip_count()).map(|s| scratch.strip(s).len()).sum();
+        assert_eq!(all, used, "from scratch walks every strip whole");
+        whole += all;
+    }
+    // Steps of a few LoDs walk a few segments; jumps (one request in
+    // five) walk more.
+    assert!(
+        walked * 20 < whole,
+        "{walked} indices walked, {whole} from scratch"
+    );
+}
+
 /// LoD sequences of the paper's Table 2 and a return trip.
 fn sequences(max_lod: usize) -> Vec<(&'static str, Vec<usize>)> {
     let linear: Vec<usize> = (0..=max_lod).collect();

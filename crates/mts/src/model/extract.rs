@@ -7,8 +7,10 @@
 //! `build.rs`, "Monotone") plus one restart that separates it from the
 //! next slot. What a strip does not use is filled with restart values,
 //! which draw nothing. A new LoD re-walks only the strips whose validity
-//! interval `[minRes, maxRes]` excludes it, and reports the slots it
-//! rewrote as dirty ranges, so a renderer uploads only those.
+//! interval `[minRes, maxRes]` excludes it, and within such a strip only
+//! from the first segment that changed to the first later one that did
+//! not ([`super::segments`]), and reports what it rewrote as dirty ranges,
+//! so a renderer uploads only those.
 //! [`Extractor::write_compact`] gives the same strips without the padding
 //! (what "indices sent" counts).
 //!
@@ -21,6 +23,7 @@
 //! (one dirty range).
 
 use super::records::{Narrow, Word, BREAK, DISTANCE, FAR, MORE, NO_ARC};
+use super::segments;
 use super::{MtsModel, END};
 use crate::strip::encode::RESTART_U32;
 use std::ops::Range;
@@ -34,6 +37,9 @@ pub struct Update {
     pub strips_walked: usize,
     /// Dirty ranges reported (see [`Extractor::dirty_ranges`]).
     pub dirty_ranges: usize,
+    /// Indices the walks wrote (a strip walked from one of its segments
+    /// counts from there, and only up to where it met an unchanged one).
+    pub indices_walked: usize,
 }
 
 /// Extracts any LoD of a model into a slot-laid index buffer, re-walking
@@ -65,6 +71,23 @@ pub struct Extractor<'m> {
     non_empty: usize,
     /// Walks cut at their slot's end (only a corrupt model can cause one).
     overflows: usize,
+    /// Per strip, where its segments start in its band's region of the
+    /// segment arrays, how many it may hold, and how many it holds (0:
+    /// not walked in the current band).
+    seg_base: Vec<u32>,
+    seg_cap: Vec<u32>,
+    seg_len: Vec<u32>,
+    /// Segments: node (record), slot offset, validity interval.
+    seg_rec: Vec<u32>,
+    seg_off: Vec<u32>,
+    seg_from: Vec<u32>,
+    seg_to: Vec<u32>,
+    /// Scratch: a walk's new part, and the segments it may meet again.
+    tmp: Vec<u32>,
+    old_rec: Vec<u32>,
+    old_off: Vec<u32>,
+    old_from: Vec<u32>,
+    old_to: Vec<u32>,
 }
 
 /// Result of walking one strip.
@@ -82,16 +105,26 @@ impl<'m> Extractor<'m> {
     pub fn new(model: &'m MtsModel) -> Extractor<'m> {
         let strips = model.strip_count();
         let mut slot_start = Vec::with_capacity(strips);
+        let mut seg_base = Vec::with_capacity(strips);
+        let mut seg_cap = Vec::with_capacity(strips);
         let mut band_len = Vec::with_capacity(model.band_count());
+        let mut segments = 0;
         for b in 0..model.band_count() {
-            let mut at = 0u32;
+            let (mut at, mut seg_at) = (0u32, 0usize);
             for s in model.band_strips(b) {
                 slot_start.push(at);
                 at += model.slot_size[s] + 1;
+                let cap = segments::capacity(model.slot_size[s]);
+                seg_base.push(seg_at as u32);
+                seg_cap.push(cap as u32);
+                seg_at += cap;
             }
             band_len.push(at);
+            segments = segments.max(seg_at);
         }
         let total = band_len.iter().copied().max().unwrap_or(0) as usize;
+        let widest = model.slot_size.iter().copied().max().unwrap_or(0);
+        let most = seg_cap.iter().copied().max().unwrap_or(0) as usize;
         Extractor {
             model,
             buffer: vec![RESTART_U32; total],
@@ -107,6 +140,18 @@ impl<'m> Extractor<'m> {
             used: 0,
             non_empty: 0,
             overflows: 0,
+            seg_base,
+            seg_cap,
+            seg_len: vec![0; strips],
+            seg_rec: vec![0; segments],
+            seg_off: vec![0; segments],
+            seg_from: vec![0; segments],
+            seg_to: vec![0; segments],
+            tmp: vec![0; widest as usize],
+            old_rec: vec![0; most],
+            old_off: vec![0; most],
+            old_from: vec![0; most],
+            old_to: vec![0; most],
         }
     }
 
@@ -145,12 +190,13 @@ impl<'m> Extractor<'m> {
         let lod = lod.min(model.max_lod());
         let band = model.band_of(lod);
         self.dirty.clear();
-        let mut walked = 0;
+        let (mut walked, mut indices) = (0, 0);
         if let Some(old) = self.band.filter(|&b| b != band) {
             // The new band's slots take the region over: forget the old
             // band's strips, pad the region, and report it whole.
             for s in model.band_strips(old) {
                 self.len[s] = 0;
+                self.seg_len[s] = 0;
                 self.valid_from[s] = 1;
                 self.valid_to[s] = 0;
             }
@@ -165,7 +211,10 @@ impl<'m> Extractor<'m> {
         }
         let birth = model.band_first_lod(band) as u32;
         for s in model.band_strips(band) {
-            walked += usize::from(self.refresh(s, birth, lod as u32, coherent));
+            if let Some(n) = self.refresh(s, birth, lod as u32, coherent) {
+                walked += 1;
+                indices += n;
+            }
         }
         self.lod = Some(lod);
         self.band = Some(band);
@@ -173,28 +222,94 @@ impl<'m> Extractor<'m> {
             lod,
             strips_walked: walked,
             dirty_ranges: self.dirty.len(),
+            indices_walked: indices,
         }
     }
 
     /// Walks strip `s` at `lod` into its slot unless (when `coherent`) its
-    /// validity interval holds `lod`. Returns whether it walked.
-    fn refresh(&mut self, s: usize, birth: u32, lod: u32, coherent: bool) -> bool {
+    /// validity interval holds `lod`; when `coherent`, only from its first
+    /// segment that `lod` changes ([`segments`]). Returns the indices it
+    /// walked, if it walked.
+    fn refresh(&mut self, s: usize, birth: u32, lod: u32, coherent: bool) -> Option<usize> {
         if coherent && self.valid_from[s] <= lod && lod <= self.valid_to[s] {
-            return false;
+            return None;
         }
-        let start = self.slot_start[s] as usize;
-        let slot = start..start + self.slot_size[s] as usize;
-        let w = walk(self.model, s, birth, lod, &mut self.buffer[slot]);
+        let base = self.seg_base[s] as usize;
+        let segs = base..base + self.seg_cap[s] as usize;
+        let n = self.seg_len[s] as usize;
+        // The first segment that `lod` changes; the segments after it may
+        // be met again if any of them still holds `lod`.
+        let (start, old_count) = if coherent && n > 0 {
+            let holds = |k: usize| self.seg_from[base + k] <= lod && lod <= self.seg_to[base + k];
+            let first = (0..n).find(|&k| !holds(k)).unwrap_or(0);
+            let kept = if (first + 1..n).any(holds) {
+                base + first + 1..base + n
+            } else {
+                0..0
+            };
+            let count = kept.len();
+            self.old_rec[..count].copy_from_slice(&self.seg_rec[kept.clone()]);
+            self.old_off[..count].copy_from_slice(&self.seg_off[kept.clone()]);
+            self.old_from[..count].copy_from_slice(&self.seg_from[kept.clone()]);
+            self.old_to[..count].copy_from_slice(&self.seg_to[kept]);
+            (first, count)
+        } else {
+            (0, 0)
+        };
+        let old_len = self.len[s] as usize;
+        let start_at = self.slot_start[s] as usize;
+        let slot = start_at..start_at + self.slot_size[s] as usize;
+        let old = segments::Old {
+            rec: &self.old_rec[..old_count],
+            off: &self.old_off[..old_count],
+            from: &self.old_from[..old_count],
+            to: &self.old_to[..old_count],
+            len: old_len,
+        };
+        let mut seg = segments::Segments {
+            rec: &mut self.seg_rec[segs.clone()],
+            off: &mut self.seg_off[segs.clone()],
+            from: &mut self.seg_from[segs.clone()],
+            to: &mut self.seg_to[segs],
+        };
+        let strip = segments::Strip {
+            model: self.model,
+            s,
+            birth,
+            lod,
+            start,
+        };
+        let (out, tmp) = (&mut self.buffer[slot], &mut self.tmp[..]);
+        let w = match (&self.model.rec_vertex, &self.model.rec_label) {
+            (Narrow::U16(v), Narrow::U16(l)) => {
+                segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
+            }
+            (Narrow::U16(v), Narrow::U32(l)) => {
+                segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
+            }
+            (Narrow::U32(v), Narrow::U16(l)) => {
+                segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
+            }
+            (Narrow::U32(v), Narrow::U32(l)) => {
+                segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
+            }
+        };
         self.overflows += usize::from(w.overflow);
-        self.set_len(s, w.len as usize);
-        self.valid_from[s] = w.from;
-        self.valid_to[s] = w.to;
-        true
+        self.seg_len[s] = w.segments as u32;
+        let (from, to) = segments::interval(
+            &self.seg_from[base..base + w.segments],
+            &self.seg_to[base..base + w.segments],
+        );
+        self.valid_from[s] = from;
+        self.valid_to[s] = to;
+        self.set_len(s, w.len, w.dirty);
+        Some(w.walked)
     }
 
     /// Records that strip `s` now uses `new` indices of its slot: pads what
-    /// it no longer uses and reports the slot's touched part as dirty.
-    fn set_len(&mut self, s: usize, new: usize) {
+    /// it no longer uses and reports the slot's part `dirty` (offsets in
+    /// the slot), with the padding, as dirty.
+    fn set_len(&mut self, s: usize, new: usize, dirty: (usize, usize)) {
         let start = self.slot_start[s] as usize;
         let old = self.len[s] as usize;
         if old > new {
@@ -203,9 +318,12 @@ impl<'m> Extractor<'m> {
         self.used = self.used + new - old;
         self.non_empty = self.non_empty + usize::from(new > 0) - usize::from(old > 0);
         self.len[s] = new as u32;
-        let touched = old.max(new);
-        if touched > 0 {
-            let range = start..start + touched;
+        // `dirty` covers the padding: a walk that shrank the strip reports
+        // up to its old length.
+        let (lo, hi) = dirty;
+        debug_assert!(old <= new || hi >= old);
+        if hi > lo {
+            let range = start + lo..start + hi;
             match self.dirty.last_mut() {
                 Some(last) if last.end + 1 >= range.start && last.start <= range.start => {
                     last.end = last.end.max(range.end);
@@ -385,7 +503,7 @@ fn walk_records<V: Word, L: Word>(
 
 /// The target of far arc `r` (the table is checked to hold every far arc).
 #[cold]
-fn far_target(model: &MtsModel, r: usize) -> usize {
+pub(crate) fn far_target(model: &MtsModel, r: usize) -> usize {
     let i = model.far.partition_point(|&(at, _)| (at as usize) < r);
     model.far[i].1 as usize
 }

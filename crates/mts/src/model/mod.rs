@@ -32,6 +32,7 @@ mod extract;
 pub mod format;
 mod pipeline;
 pub(crate) mod records;
+mod segments;
 pub mod sequence;
 mod verify;
 

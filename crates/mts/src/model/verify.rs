@@ -94,11 +94,23 @@ pub fn verify(model: &MtsModel, mesh: &Mesh, lods: &[usize]) -> VerifyReport {
         first_mismatch: None,
     };
     let mut decoded = Vec::new();
+    let mut runs: Vec<Range<usize>> = Vec::new();
     for &lod in lods {
         let lod = lod.min(model.max_lod());
         oracle.advance(lod, &mut tally);
         coherent.set_lod(lod);
+        // A dirty range may start inside a run (a strip re-walked from one
+        // of its segments): widen each to whole runs, which the two
+        // buffers share outside the ranges, before decoding.
+        runs.clear();
         for r in coherent.dirty_ranges() {
+            let r = whole_runs(coherent.buffer(), r.clone());
+            match runs.last_mut() {
+                Some(last) if last.end >= r.start => last.end = last.end.max(r.end),
+                _ => runs.push(r),
+            }
+        }
+        for r in &runs {
             decode_range(&shadow, r.clone(), &mut decoded);
             for t in decoded.drain(..) {
                 tally.add(t, -1);
@@ -156,6 +168,21 @@ fn first_difference(a: &Extractor<'_>, b: &Extractor<'_>) -> Option<usize> {
 }
 
 /// The oriented triangles of `buffer[range]`, runs split at restarts.
+/// `range` widened to the runs it touches: back to just after a restart
+/// (or the buffer's start), on to a restart (or the buffer's end).
+fn whole_runs(buffer: &[u32], range: Range<usize>) -> Range<usize> {
+    use crate::strip::encode::RESTART_U32;
+    let mut lo = range.start;
+    while lo > 0 && buffer[lo - 1] != RESTART_U32 {
+        lo -= 1;
+    }
+    let mut hi = range.end;
+    while hi < buffer.len() && buffer[hi] != RESTART_U32 {
+        hi += 1;
+    }
+    lo..hi
+}
+
 fn decode_range(buffer: &[u32], range: Range<usize>, out: &mut Vec<[u32; 3]>) {
     crate::encoding::decode_restart_buffer(&buffer[range], out);
 }
