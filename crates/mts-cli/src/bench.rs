@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 4;
+pub const SCHEMA_VERSION: u32 = 5;
 
 /// Shares of the full triangle count reported in Tables 3–4.
 const SHARES: [f64; 6] = mts::methods::SHARES;
@@ -672,6 +672,7 @@ fn measure_model(
             raw: model.raw_bytes() as u64,
             raw_u16: model.raw_bytes_u16() as u64,
             mts_file: file_bytes as u64,
+            mts_recipe_file: model.to_recipe_bytes().len() as u64,
             mts_memory: stats.memory_bytes as u64,
         },
         build_ms: BuildMs {
@@ -839,7 +840,13 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Result<Scale> {
         });
         let (model_bytes, rss) = (model.stats().memory_bytes, peak_rss());
         drop(ex);
+        let file = model.to_bytes();
         drop(model);
+        let load_ms = time_us(3, || {
+            let m = mts::MtsModel::from_bytes(&file, std::path::Path::new("scale.mts"))
+                .expect("a file just written loads");
+            std::hint::black_box(Extractor::new(&m).buffer().len());
+        }) / 1e3;
         // Each stage alone (the pipeline runs stripify beside simplify),
         // against meshoptimizer, one run each.
         let ((_, stripify_ms), (_, meshopt_stripify_ms)) = interleaved_ms(
@@ -861,6 +868,8 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Result<Scale> {
             meshopt_simplify_to_10_ms: meshopt_simplify_ms,
             build_ms: t.total.as_secs_f64() * 1e3,
             model_bytes: model_bytes as u64,
+            file_bytes: file.len() as u64,
+            load_ms,
             extract_lod0_us: extract_us,
             peak_rss_bytes: rss
                 .context("cannot read the peak memory (VmHWM of /proc/self/status)")?,
@@ -884,6 +893,7 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Result<Scale> {
         meshopt_simplify_to_10_ms: fit(|r| r.meshopt_simplify_to_10_ms),
         build_ms: fit(|r| r.build_ms),
         model_bytes: fit(|r| r.model_bytes as f64),
+        load_ms: fit(|r| r.load_ms),
         extract_lod0_us: fit(|r| r.extract_lod0_us),
     };
     Ok(Scale { rows, exponent })
@@ -930,12 +940,12 @@ pub fn figure6_row<'r>(
 /// README's).
 pub fn scale_table(s: &mut String, scale: &Scale) {
     let _ = writeln!(s, "Stripify and simplify (whole sequence) each timed alone, beside meshoptimizer's `stripify` and `simplify` to 10%; build is the whole pipeline (stripify beside simplify, then the model).\n");
-    let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes | peak RSS bytes (process so far) | LoD 0 extraction µs |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes (per triangle) | .mts bytes | load ms (parse, validate, extractor ready) | peak RSS bytes (process so far) | LoD 0 extraction µs |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
     for r in &scale.rows {
         let _ = writeln!(
             s,
-            "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} | {} | {:.0} |",
+            "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} ({:.1}) | {} | {:.1} | {} | {:.0} |",
             r.triangles,
             r.stripify_ms,
             r.meshopt_stripify_ms,
@@ -943,6 +953,9 @@ pub fn scale_table(s: &mut String, scale: &Scale) {
             r.meshopt_simplify_to_10_ms,
             r.build_ms,
             r.model_bytes,
+            r.model_bytes as f64 / r.triangles.max(1) as f64,
+            r.file_bytes,
+            r.load_ms,
             r.peak_rss_bytes,
             r.extract_lod0_us,
         );
@@ -950,13 +963,14 @@ pub fn scale_table(s: &mut String, scale: &Scale) {
     let e = &scale.exponent;
     let _ = writeln!(
         s,
-        "\nFitted growth exponents (y ~ triangles^k): stripify {:.2} (meshoptimizer {:.2}), simplify {:.2} (meshoptimizer to 10% {:.2}), build {:.2}, model bytes {:.2}, LoD 0 extraction {:.2}.",
+        "\nFitted growth exponents (y ~ triangles^k): stripify {:.2} (meshoptimizer {:.2}), simplify {:.2} (meshoptimizer to 10% {:.2}), build {:.2}, model bytes {:.2}, load {:.2}, LoD 0 extraction {:.2}.",
         e.stripify_ms,
         e.meshopt_stripify_ms,
         e.simplify_ms,
         e.meshopt_simplify_to_10_ms,
         e.build_ms,
         e.model_bytes,
+        e.load_ms,
         e.extract_lod0_us,
     );
 }
@@ -1018,13 +1032,17 @@ pub fn report(results: &Results) -> String {
         results.command, results.elapsed_s,
     );
     let _ = writeln!(s, "## Table 1: models and sizes (bytes)\n");
-    let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | MTS in memory | build ms (stripify ‖ simplify, model, total) |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "The `.mts` file holds the model ready to walk (version 3); the recipe-only file (`mts build --recipe-only`) loads by building the graphs again. Memory is the model's arrays with its vertices and their properties.\n");
+    let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | recipe-only .mts / raw | MTS in memory | memory / raw | memory bytes / triangle | build ms (stripify ‖ simplify, model, total) |");
+    let _ = writeln!(
+        s,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for r in models {
         let (b, t) = (&r.bytes, &r.build_ms);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
             r.name,
             r.strips,
             r.triangles,
@@ -1035,7 +1053,10 @@ pub fn report(results: &Results) -> String {
             b.raw_u16,
             b.mts_file,
             b.mts_file as f64 / b.raw as f64,
+            b.mts_recipe_file as f64 / b.raw as f64,
             b.mts_memory,
+            b.mts_memory as f64 / b.raw as f64,
+            b.mts_memory as f64 / r.triangles.max(1) as f64,
             t.stripify,
             t.simplify,
             t.model,
@@ -1045,27 +1066,34 @@ pub fn report(results: &Results) -> String {
     let _ = writeln!(s, "\n## Strips against meshoptimizer\n");
     strips_table(&mut s, models);
     let _ = writeln!(s, "\n### Table 1, every method: bytes and build time\n");
-    let _ = writeln!(s, "File bytes against the raw mesh with 16-bit indices (12 per vertex + 6 per triangle, the cluster-tree paper's reference). MTS builds the whole pipeline; the baselines start from the mesh and MTS's contraction sequence (the cluster tree makes its own clustering). Multilevel has no file format of its own: its figure is the in-memory structure.\n");
+    let _ = writeln!(s, "File bytes against the raw mesh with 16-bit indices (12 per vertex + 6 per triangle, the cluster-tree paper's reference). MTS builds the whole pipeline; the baselines start from the mesh and MTS's contraction sequence (the cluster tree makes its own clustering). Multilevel has no file format of its own: its figure is the in-memory structure. Load: median of 5, from the file's bytes in memory to a source ready for its first LoD (MTS: parse, validate, extractor; progressive mesh: parse; cluster tree: decode the whole packet stream, its receiver's work); multilevel and discrete LoDs have no file reader.\n");
     let _ = writeln!(
         s,
-        "| model | method | file bytes | file / raw 16-bit | memory bytes | build ms |"
+        "| model | method | file bytes | file / raw 16-bit | memory bytes | memory bytes / triangle | load ms | build ms |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
     for r in models {
         for m in &r.methods {
             let _ = match m {
                 MethodRow::Measured(m) => writeln!(
                     s,
-                    "| {} | {} | {} | {:.3} | {} | {:.0} |",
+                    "| {} | {} | {} | {:.3} | {} | {:.1} | {} | {:.0} |",
                     r.name,
                     m.method,
                     m.file_bytes,
                     m.file_ratio_to_raw_u16,
                     m.memory_bytes,
+                    m.memory_bytes as f64 / r.triangles.max(1) as f64,
+                    m.load_ms
+                        .map_or("no reader".to_string(), |ms| format!("{ms:.2}")),
                     m.build_ms,
                 ),
                 MethodRow::Skipped { method, skipped } => {
-                    writeln!(s, "| {} | {method} | skipped: {skipped} | | | |", r.name)
+                    writeln!(
+                        s,
+                        "| {} | {method} | skipped: {skipped} | | | | | |",
+                        r.name
+                    )
                 }
             };
         }

@@ -120,7 +120,11 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
         );
         let b = &m.bytes;
         need(
-            b.raw > 0 && b.raw_u16 > 0 && b.mts_file > 0 && b.mts_memory > 0,
+            b.raw > 0
+                && b.raw_u16 > 0
+                && b.mts_file > 0
+                && b.mts_recipe_file > 0
+                && b.mts_memory > 0,
             at("bytes: a size is 0"),
         );
         for seq in ["linear", "exponential", "random"] {
@@ -168,6 +172,12 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
                 need(
                     x.file_bytes > 0 && x.memory_bytes > 0,
                     at(&format!("method {}: a size is 0", x.method)),
+                );
+                // The methods with a file reader report its load time.
+                let reads = matches!(x.method.as_str(), "mts" | "pm" | "cluster");
+                need(
+                    x.load_ms.is_some_and(|ms| ms > 0.0) == reads,
+                    at(&format!("method {}: load time {:?}", x.method, x.load_ms)),
                 );
             }
         }

@@ -1709,17 +1709,68 @@ fn measure_methods(
                 .collect::<BTreeMap<_, _>>()
         });
         let file = source.file_bytes();
+        let load_ms = load_ms_of(method, model, mesh)?;
         rows.push(MethodRow::Measured(results::Method {
             method: source.name().to_string(),
             build_ms,
             memory_bytes: source.memory_bytes() as u64,
             file_bytes: file as u64,
             file_ratio_to_raw_u16: file as f64 / raw as f64,
+            load_ms,
             us_per_change: us,
             us_per_change_scratch: scratch,
         }));
     }
     Ok(rows)
+}
+
+/// Median milliseconds (of 5) from a method's file bytes in memory to a
+/// source ready for its first LoD: MTS parses and validates its ready
+/// `.mts` and makes an extractor; the progressive mesh parses its file; the
+/// cluster tree decodes its whole packet stream (its receiver). `None` for
+/// the methods without a file reader (multilevel, discrete LoDs).
+fn load_ms_of(method: Method, model: &mts::MtsModel, mesh: &Mesh) -> Result<Option<f64>> {
+    use mts::baselines::{cluster, ClusterTree, ProgressiveMesh};
+    const RUNS: usize = 5;
+    Ok(match method {
+        Method::Mts => {
+            let bytes = model.to_bytes();
+            let file = std::path::Path::new("model.mts");
+            let mut ok = Ok(());
+            let (_, ms) = median_ms(RUNS, || match mts::MtsModel::from_bytes(&bytes, file) {
+                Ok(m) => std::hint::black_box(mts::Extractor::new(&m).buffer().len()),
+                Err(e) => {
+                    ok = Err(e);
+                    0
+                }
+            });
+            ok?;
+            Some(ms)
+        }
+        Method::Pm => {
+            let bytes = ProgressiveMesh::new(mesh, model.collapses())?.to_bytes();
+            let mut ok = Ok(());
+            let (_, ms) = median_ms(RUNS, || {
+                if let Err(e) = ProgressiveMesh::from_bytes(&bytes, "model.pm") {
+                    ok = Err(e);
+                }
+            });
+            ok?;
+            Some(ms)
+        }
+        Method::Cluster => {
+            let bytes = ClusterTree::new(mesh)?.to_stream();
+            let mut ok = Ok(());
+            let (_, ms) = median_ms(RUNS, || {
+                if let Err(e) = cluster::stream::decode(&bytes, "model.stream") {
+                    ok = Err(e);
+                }
+            });
+            ok?;
+            Some(ms)
+        }
+        Method::Multilevel | Method::Discrete => None,
+    })
 }
 
 fn compare(args: &CompareArgs) -> Result<()> {
@@ -1748,8 +1799,16 @@ fn compare(args: &CompareArgs) -> Result<()> {
         args.requests
     );
     println!(
-        "{:<12}{:>10}{:>12}{:>12}{:>8}{:>10}{:>10}{:>10}",
-        "method", "build ms", "memory B", "file B", "/raw", "us lin", "us exp", "us rand"
+        "{:<12}{:>10}{:>12}{:>12}{:>8}{:>10}{:>10}{:>10}{:>10}",
+        "method",
+        "build ms",
+        "memory B",
+        "file B",
+        "/raw",
+        "load ms",
+        "us lin",
+        "us exp",
+        "us rand"
     );
     for r in &rows {
         let r = match r {
@@ -1761,12 +1820,13 @@ fn compare(args: &CompareArgs) -> Result<()> {
         };
         let us = |seq: &str| r.us_per_change.get(seq).copied().unwrap_or(0.0);
         println!(
-            "{:<12}{:>10.1}{:>12}{:>12}{:>8.3}{:>10.1}{:>10.1}{:>10.1}",
+            "{:<12}{:>10.1}{:>12}{:>12}{:>8.3}{:>10}{:>10.1}{:>10.1}{:>10.1}",
             r.method,
             r.build_ms,
             r.memory_bytes,
             r.file_bytes,
             r.file_ratio_to_raw_u16,
+            r.load_ms.map_or("-".to_string(), |ms| format!("{ms:.2}")),
             us("linear"),
             us("exponential"),
             us("random"),
@@ -1774,7 +1834,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
         if let Some(scratch) = &r.us_per_change_scratch {
             let s = |seq: &str| scratch.get(seq).copied().unwrap_or(0.0);
             println!(
-                "{:<12}{:>52}{:>10.1}{:>10.1}{:>10.1}  (coherent {:.2}x / {:.2}x / {:.2}x faster)",
+                "{:<12}{:>62}{:>10.1}{:>10.1}{:>10.1}  (coherent {:.2}x / {:.2}x / {:.2}x faster)",
                 "  scratch",
                 "",
                 s("linear"),

@@ -99,6 +99,8 @@ pub struct Bytes {
     pub raw: u64,
     pub raw_u16: u64,
     pub mts_file: u64,
+    /// The recipe-only `.mts` (`mts build --recipe-only`).
+    pub mts_recipe_file: u64,
     pub mts_memory: u64,
 }
 
@@ -221,6 +223,9 @@ pub struct Method {
     pub memory_bytes: u64,
     pub file_bytes: u64,
     pub file_ratio_to_raw_u16: f64,
+    /// From the file's bytes in memory to a source ready for its first
+    /// LoD (median ms); `null` for a method without a file reader.
+    pub load_ms: Option<f64>,
     pub us_per_change: BTreeMap<String, f64>,
     /// MTS only: the same requests, each LoD extracted from scratch (every
     /// strip walked), against which `us_per_change` shows coherence.
@@ -268,6 +273,10 @@ pub struct ScaleRow {
     pub meshopt_simplify_to_10_ms: f64,
     pub build_ms: f64,
     pub model_bytes: u64,
+    /// The ready `.mts` file, and loading it (parse, validate, extractor
+    /// ready; median ms).
+    pub file_bytes: u64,
+    pub load_ms: f64,
     pub extract_lod0_us: f64,
     pub peak_rss_bytes: u64,
 }
@@ -282,6 +291,7 @@ pub struct ScaleExponent {
     pub meshopt_simplify_to_10_ms: f64,
     pub build_ms: f64,
     pub model_bytes: f64,
+    pub load_ms: f64,
     pub extract_lod0_us: f64,
 }
 

@@ -233,8 +233,20 @@ fn a_long_strip_rewalks_from_its_segments() {
     // Steps of a few LoDs walk a few segments; jumps (one request in
     // five) walk more.
     assert!(
-        walked * 20 < whole,
+        walked * 10 < whole,
         "{walked} indices walked, {whole} from scratch"
+    );
+    // One-step changes near LoD 0 walk a few segments of 32 indices each,
+    // not the strip.
+    coherent.set_lod(0);
+    let mut walked = 0;
+    for i in 0..200 {
+        walked += coherent.set_lod(1 + i % 2).indices_walked;
+    }
+    let sent = coherent.indices_sent();
+    assert!(
+        walked < 200 * 256,
+        "{walked} indices walked in 200 one-step changes of a {sent}-index buffer"
     );
 }
 

@@ -242,7 +242,10 @@ impl<'m> Extractor<'m> {
         let (start, old_count) = if coherent && n > 0 {
             let holds = |k: usize| self.seg_from[base + k] <= lod && lod <= self.seg_to[base + k];
             let first = (0..n).find(|&k| !holds(k)).unwrap_or(0);
-            let kept = if (first + 1..n).any(holds) {
+            // Worth meeting again only if most later segments still hold
+            // (else the walk of the whole rest is cheaper than the checks).
+            let holding = (first + 1..n).filter(|&k| holds(k)).count();
+            let kept = if 2 * holding > n - first - 1 {
                 base + first + 1..base + n
             } else {
                 0..0

@@ -175,7 +175,15 @@ pub(crate) fn rewalk<V: Word, L: Word>(
                 let m = (j + 1..old.rec.len()).find(|&m| !holds(m));
                 let kept = m.unwrap_or(old.rec.len()) - j;
                 let (p, q) = (origin + t, (old.off[j] as isize + shift) as usize);
-                if k + 1 + kept + usize::from(m.is_some()) <= cap && p + (old_end - q) <= out.len()
+                // Keeping costs a move of the whole tail when the length
+                // changed: worth it only when the kept part is at least a
+                // sixteenth of that tail (a move is that much cheaper per
+                // index than a walk).
+                let kept_to = m.map_or(old_end, |m| (old.off[m] as isize + shift) as usize);
+                let worth = p == q || 16 * (kept_to - q) >= old_end - q;
+                if worth
+                    && k + 1 + kept + usize::from(m.is_some()) <= cap
+                    && p + (old_end - q) <= out.len()
                 {
                     finish(segs, k, from, to);
                     if p != q {
