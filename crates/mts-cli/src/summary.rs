@@ -318,7 +318,10 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
             s,
             &format!("{t:.0}-triangle icosphere: MTS model in memory against the raw mesh"),
             "≤ 3 ×",
-            format!("{memory:.2} × ({:.1} bytes per triangle)", r.model_bytes as f64 / t),
+            format!(
+                "{memory:.2} × ({:.1} bytes per triangle)",
+                r.model_bytes as f64 / t
+            ),
             memory <= 3.0,
         );
         row(

@@ -17,9 +17,7 @@ use std::path::Path;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let path = args
-        .get(1)
-        .ok_or("usage: band_tradeoff MESH [SLACK...]")?;
+    let path = args.get(1).ok_or("usage: band_tradeoff MESH [SLACK...]")?;
     let mut slacks: Vec<f64> = args[2..]
         .iter()
         .map(|s| s.parse::<f64>())
@@ -53,7 +51,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for slack in slacks {
         let (model, sent) = indices(slack);
         let at = |r: f64| {
-            let i = shares.iter().position(|&s| (s - r).abs() < 1e-9).expect("a share");
+            let i = shares
+                .iter()
+                .position(|&s| (s - r).abs() < 1e-9)
+                .expect("a share");
             sent[i] / model.triangle_count(model.lod_for_ratio(r)).max(1) as f64
         };
         let ratios: Vec<f64> = sent.iter().zip(&reference).map(|(a, b)| a / b).collect();
