@@ -504,7 +504,7 @@ impl<'m> InstancedScene<'m> {
             // Slots (live or free) and the free list.
             m.cpu_instance_bytes += entry.slots.capacity() * std::mem::size_of::<Instance>()
                 + entry.free.capacity() * 4;
-            m.cpu_shared_bytes += 4 * entry.cursor.buffer().len()
+            m.cpu_shared_bytes += entry.cursor.memory_bytes()
                 + entry.buckets.capacity() * std::mem::size_of::<Bucket>();
             m.gpu_vertex_bytes += entry.renderer.vertex_count() * crate::VERTEX_BYTES;
             for b in &entry.buckets {

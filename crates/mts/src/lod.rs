@@ -137,7 +137,7 @@ impl LodSource for Extractor<'_> {
     }
 
     fn memory_bytes(&self) -> usize {
-        self.model().stats().memory_bytes + 4 * self.buffer().len()
+        self.model().stats().memory_bytes + Extractor::memory_bytes(self)
     }
 
     /// Serializes the model (O(model)).

@@ -380,6 +380,32 @@ impl<'m> Extractor<'m> {
         self.used + self.non_empty.saturating_sub(1)
     }
 
+    /// Bytes of the extractor's own arrays (the index buffer, per-strip
+    /// state, segments and scratch), not counting the model.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        let words = self.buffer.len()
+            + self.slot_start.len()
+            + self.slot_size.len()
+            + self.band_len.len()
+            + self.len.len()
+            + self.valid_from.len()
+            + self.valid_to.len()
+            + self.seg_base.len()
+            + self.seg_cap.len()
+            + self.seg_len.len()
+            + self.seg_rec.len()
+            + self.seg_off.len()
+            + self.seg_from.len()
+            + self.seg_to.len()
+            + self.tmp.len()
+            + self.old_rec.len()
+            + self.old_off.len()
+            + self.old_from.len()
+            + self.old_to.len();
+        4 * words + std::mem::size_of::<Range<usize>>() * self.dirty.capacity()
+    }
+
     /// Strip walks that hit the end of their slot and were cut (always 0
     /// for a model from [`super::build`]; a corrupt file can cause it).
     #[must_use]
