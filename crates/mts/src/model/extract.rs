@@ -241,10 +241,18 @@ impl<'m> Extractor<'m> {
         // be met again if any of them still holds `lod`.
         let (start, old_count) = if coherent && n > 0 {
             let holds = |k: usize| self.seg_from[base + k] <= lod && lod <= self.seg_to[base + k];
-            let first = (0..n).find(|&k| !holds(k)).unwrap_or(0);
-            // Worth meeting again only if most later segments still hold
-            // (else the walk of the whole rest is cheaper than the checks).
-            let holding = (first + 1..n).filter(|&k| holds(k)).count();
+            // One pass: the first changed segment, and how many after it
+            // still hold. Meeting them again is worth it only if most do
+            // (else walking the whole rest is cheaper than the checks).
+            let (mut first, mut holding) = (None, 0);
+            for k in 0..n {
+                match (first, holds(k)) {
+                    (None, false) => first = Some(k),
+                    (Some(_), true) => holding += 1,
+                    _ => {}
+                }
+            }
+            let first = first.unwrap_or(0);
             let kept = if 2 * holding > n - first - 1 {
                 base + first + 1..base + n
             } else {

@@ -268,8 +268,8 @@ impl MtsModel {
     /// naming the byte offset and section of the first problem otherwise
     /// (truncation, checksum, counts, indices, labels).
     pub fn from_bytes(bytes: &[u8], file: &Path) -> Result<MtsModel> {
-        let parsed = parse(bytes, file)?;
-        let Some(mut modl) = parsed.modl.clone() else {
+        let mut parsed = parse(bytes, file)?;
+        let Some(arrays) = parsed.arrays.take() else {
             let model = build(
                 &parsed.mesh,
                 &parsed.strips,
@@ -287,8 +287,8 @@ impl MtsModel {
             })?;
             return Ok(model);
         };
-        let at = modl.base;
-        let model = read_model(&mut modl, parsed)?;
+        let at = parsed.modl.as_ref().map_or(0, |m| m.base);
+        let model = assemble(arrays?, parsed);
         model
             .validate()
             .map_err(|e| parse_error(file, at, "MODL", e.message))?;
@@ -320,8 +320,10 @@ pub fn seal(bytes: &mut [u8]) {
 struct Parsed<'a> {
     /// Every vertex, appended ones too.
     positions: Vec<Vec3>,
-    /// Version 3's ready model, not yet read.
+    /// Version 3's `MODL` section, and its arrays (read on a second
+    /// thread while the recipe is parsed).
     modl: Option<Reader<'a>>,
+    arrays: Option<Result<Arrays>>,
     /// The input vertices with their properties, and (before version 3)
     /// the strips' triangles to build from.
     mesh: Mesh,
@@ -626,147 +628,161 @@ fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
         return Err(meta.error(format!("{vertices} vertices is too many")));
     }
 
-    // POSI.
-    let mut positions = Vec::with_capacity(vertices + appended);
-    for i in 0..vertices + appended {
-        let p = Vec3::new(posi.f32()?, posi.f32()?, posi.f32()?);
-        if !p.is_finite() {
-            posi.pos -= 12;
-            return Err(posi.error(format!("vertex {i} is not finite: {p}")));
-        }
-        positions.push(p);
-    }
-    posi.finish()?;
+    // The model's arrays are read on a second thread while the recipe is
+    // parsed (version 3).
+    let arrays_reader = modl.clone();
+    std::thread::scope(|scope| {
+        let reading = arrays_reader.map(|m| scope.spawn(move || read_arrays(m, steps)));
+        let rest = (move || -> Result<Parsed<'a>> {
+            // POSI.
+            let mut positions = Vec::with_capacity(vertices + appended);
+            for i in 0..vertices + appended {
+                let p = Vec3::new(posi.f32()?, posi.f32()?, posi.f32()?);
+                if !p.is_finite() {
+                    posi.pos -= 12;
+                    return Err(posi.error(format!("vertex {i} is not finite: {p}")));
+                }
+                positions.push(p);
+            }
+            posi.finish()?;
 
-    // STRP.
-    let mut starts = Vec::with_capacity(runs + 1);
-    starts.push(0u32);
-    let mut total = 0usize;
-    for r in 0..runs {
-        let len = strp.count("run length", indices as u64)?;
-        if len < 3 {
-            return Err(strp.error(format!("run {r} has {len} vertices")));
-        }
-        total += len;
-        if total > indices {
-            return Err(strp.error(format!(
-                "runs hold more than the {indices} indices announced"
-            )));
-        }
-        starts.push(total as u32);
-    }
-    if total != indices {
-        return Err(strp.error(format!("runs hold {total} indices, {indices} announced")));
-    }
-    let mut all = Vec::with_capacity(indices);
-    let mut prev = 0i64;
-    for i in 0..indices {
-        let at = strp.pos;
-        let v = prev + unzigzag(strp.varint()?);
-        if v < 0 || v >= vertices as i64 {
-            strp.pos = at;
-            return Err(strp.error(format!(
-                "strip index {i} is {v}, vertices are 0..{vertices}"
-            )));
-        }
-        all.push(v as u32);
-        prev = v;
-    }
-    strp.finish()?;
-    let strips = Strips::from_runs(
-        starts
-            .windows(2)
-            .map(|w| &all[w[0] as usize..w[1] as usize]),
-        vertices as u32,
-    )
-    .map_err(|e| strp.error(e.to_string()))?;
-    // A ready model needs no mesh to build from.
-    let mut mesh = Mesh {
-        positions: positions[..vertices].to_vec(),
-        triangles: if modl.is_some() {
-            Vec::new()
-        } else {
-            strips.triangles()
-        },
-        properties: Default::default(),
-    };
-    if let Some(mut prop) = prop {
-        mesh.properties = read_properties(&mut prop, &mesh.positions)?;
-    }
-    if strips.triangle_count() == 0 {
-        return Err(strp.error("the strips draw no triangle"));
-    }
+            // STRP.
+            let mut starts = Vec::with_capacity(runs + 1);
+            starts.push(0u32);
+            let mut total = 0usize;
+            for r in 0..runs {
+                let len = strp.count("run length", indices as u64)?;
+                if len < 3 {
+                    return Err(strp.error(format!("run {r} has {len} vertices")));
+                }
+                total += len;
+                if total > indices {
+                    return Err(strp.error(format!(
+                        "runs hold more than the {indices} indices announced"
+                    )));
+                }
+                starts.push(total as u32);
+            }
+            if total != indices {
+                return Err(strp.error(format!("runs hold {total} indices, {indices} announced")));
+            }
+            let mut all = Vec::with_capacity(indices);
+            let mut prev = 0i64;
+            for i in 0..indices {
+                let at = strp.pos;
+                let v = prev + unzigzag(strp.varint()?);
+                if v < 0 || v >= vertices as i64 {
+                    strp.pos = at;
+                    return Err(strp.error(format!(
+                        "strip index {i} is {v}, vertices are 0..{vertices}"
+                    )));
+                }
+                all.push(v as u32);
+                prev = v;
+            }
+            strp.finish()?;
+            let strips = Strips::from_runs(
+                starts
+                    .windows(2)
+                    .map(|w| &all[w[0] as usize..w[1] as usize]),
+                vertices as u32,
+            )
+            .map_err(|e| strp.error(e.to_string()))?;
+            // A ready model needs no mesh to build from.
+            let mut mesh = Mesh {
+                positions: positions[..vertices].to_vec(),
+                triangles: if modl.is_some() {
+                    Vec::new()
+                } else {
+                    strips.triangles()
+                },
+                properties: Default::default(),
+            };
+            if let Some(mut prop) = prop {
+                mesh.properties = read_properties(&mut prop, &mesh.positions)?;
+            }
+            if strips.triangle_count() == 0 {
+                return Err(strp.error("the strips draw no triangle"));
+            }
 
-    // STEP: a valid sequence (each vertex removed once, never used after).
-    let total_vertices = vertices + appended;
-    let mut removed_at = vec![false; total_vertices];
-    let mut list = Vec::with_capacity(steps);
-    let mut last_error = 0.0f32;
-    for i in 0..steps {
-        let at = step.pos;
-        let limit = if optimal { vertices + i } else { vertices };
-        let removed = step.count("removed vertex", total_vertices as u64)?;
-        let kept = step.count("kept vertex", total_vertices as u64)?;
-        let error = step.f32()?;
-        let problem = if removed >= limit || kept >= limit {
-            Some(format!(
-                "names a vertex not present at that step ({removed}, {kept})"
-            ))
-        } else if removed == kept {
-            Some(format!("contracts vertex {removed} onto itself"))
-        } else if removed_at[removed] || removed_at[kept] {
-            Some(format!("uses a removed vertex ({removed}, {kept})"))
-        } else if !error.is_finite() || error < last_error {
-            Some(format!("error {error} is not finite or decreases"))
-        } else {
-            None
-        };
-        if let Some(p) = problem {
-            step.pos = at;
-            return Err(step.error(format!("step {i} {p}")));
-        }
-        removed_at[removed] = true;
-        if optimal {
-            removed_at[kept] = true;
-        }
-        last_error = error;
-        list.push(Collapse {
-            removed: removed as u32,
-            kept: kept as u32,
-            error,
-        });
-    }
-    step.finish()?;
-    let companions = match cmpn {
-        Some(mut r) => read_companions(&mut r, &list, vertices, optimal)?,
-        None => Vec::new(),
-    };
-    let appended_positions = positions[vertices..].to_vec();
-    // Version 3 stores the triangle counts with the model (read and
-    // checked by `read_model`); earlier versions replay them.
-    let counts = if let Some(m) = &modl {
-        table_at_end(m, list.len() + 1, strips.triangle_count() as u32)?
-    } else {
-        replay_counts(&mesh, &list, optimal, &companions)
-    };
-    let collapses =
-        Collapses::with_companions(vertices, list, counts, appended_positions, companions);
-    Ok(Parsed {
-        positions,
-        modl,
-        mesh,
-        strips,
-        collapses,
-        options: BuildOptions {
-            band_slack,
-            stripify: StripifyOptions {
-                patches,
-                min_patch_quads,
-                swap_penalties,
-                join_ends,
-                cache_aware,
-            },
-        },
+            // STEP: a valid sequence (each vertex removed once, never used after).
+            let total_vertices = vertices + appended;
+            let mut removed_at = vec![false; total_vertices];
+            let mut list = Vec::with_capacity(steps);
+            let mut last_error = 0.0f32;
+            for i in 0..steps {
+                let at = step.pos;
+                let limit = if optimal { vertices + i } else { vertices };
+                let removed = step.count("removed vertex", total_vertices as u64)?;
+                let kept = step.count("kept vertex", total_vertices as u64)?;
+                let error = step.f32()?;
+                let problem = if removed >= limit || kept >= limit {
+                    Some(format!(
+                        "names a vertex not present at that step ({removed}, {kept})"
+                    ))
+                } else if removed == kept {
+                    Some(format!("contracts vertex {removed} onto itself"))
+                } else if removed_at[removed] || removed_at[kept] {
+                    Some(format!("uses a removed vertex ({removed}, {kept})"))
+                } else if !error.is_finite() || error < last_error {
+                    Some(format!("error {error} is not finite or decreases"))
+                } else {
+                    None
+                };
+                if let Some(p) = problem {
+                    step.pos = at;
+                    return Err(step.error(format!("step {i} {p}")));
+                }
+                removed_at[removed] = true;
+                if optimal {
+                    removed_at[kept] = true;
+                }
+                last_error = error;
+                list.push(Collapse {
+                    removed: removed as u32,
+                    kept: kept as u32,
+                    error,
+                });
+            }
+            step.finish()?;
+            let companions = match cmpn {
+                Some(mut r) => read_companions(&mut r, &list, vertices, optimal)?,
+                None => Vec::new(),
+            };
+            let appended_positions = positions[vertices..].to_vec();
+            // Version 3 stores the triangle counts with the model (read and
+            // checked by `read_model`); earlier versions replay them.
+            let counts = if let Some(m) = &modl {
+                table_at_end(m, list.len() + 1, strips.triangle_count() as u32)?
+            } else {
+                replay_counts(&mesh, &list, optimal, &companions)
+            };
+            let collapses =
+                Collapses::with_companions(vertices, list, counts, appended_positions, companions);
+            Ok(Parsed {
+                positions,
+                modl,
+                arrays: None,
+                mesh,
+                strips,
+                collapses,
+                options: BuildOptions {
+                    band_slack,
+                    stripify: StripifyOptions {
+                        patches,
+                        min_patch_quads,
+                        swap_penalties,
+                        join_ends,
+                        cache_aware,
+                    },
+                },
+            })
+        })();
+        let arrays = reading.map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
+        rest.map(|mut p| {
+            p.arrays = arrays;
+            p
+        })
     })
 }
 
@@ -775,8 +791,26 @@ const SECTION_NAMES: [&str; 7] = ["META", "POSI", "STRP", "STEP", "PROP", "CMPN"
 /// Reads the `MODL` section into the model `parsed` describes. Every count
 /// is bounded by the bytes left before anything is allocated; the
 /// structure is checked afterwards by [`MtsModel::validate`].
-fn read_model(r: &mut Reader<'_>, parsed: Parsed<'_>) -> Result<MtsModel> {
-    let max_lod = parsed.collapses.max_lod();
+/// The graph arrays of the `MODL` section, before they join the recipe.
+struct Arrays {
+    strip_records: Vec<u32>,
+    strip_begins: Vec<u32>,
+    begin_node: Vec<u32>,
+    begin_res: Vec<u32>,
+    rec_vertex: Narrow,
+    rec_label: Narrow,
+    rec_code: Vec<u8>,
+    far: Vec<(u32, u32)>,
+    slot_size: Vec<u32>,
+    band_lod: Vec<u32>,
+    band_strips: Vec<u32>,
+}
+
+/// Reads the `MODL` section's arrays for a model of `max_lod`
+/// contractions. Every count is bounded by the bytes left before anything
+/// is allocated; the structure is checked afterwards by
+/// [`MtsModel::validate`].
+fn read_arrays(mut r: Reader<'_>, max_lod: usize) -> Result<Arrays> {
     let left = r.remaining() as u64;
     let strips = r.count("strip count", left / 12)?;
     let bands = r.count("band count", left / 8)?;
@@ -828,12 +862,10 @@ fn read_model(r: &mut Reader<'_>, parsed: Parsed<'_>) -> Result<MtsModel> {
     let rec_code = r.take(records)?.to_vec();
     let far_words = r.words(2 * far)?;
     let far = far_words.chunks_exact(2).map(|p| (p[0], p[1])).collect();
-    // The LoD → triangle table, read by `parse` already.
+    // The LoD → triangle table, read by `parse` (`table_at_end`).
     r.take(4 * (max_lod + 1))?;
     r.finish()?;
-    Ok(MtsModel {
-        positions: parsed.positions,
-        properties: parsed.mesh.properties,
+    Ok(Arrays {
         strip_records,
         strip_begins,
         begin_node,
@@ -845,12 +877,31 @@ fn read_model(r: &mut Reader<'_>, parsed: Parsed<'_>) -> Result<MtsModel> {
         slot_size,
         band_lod,
         band_strips,
+    })
+}
+
+/// The model of a version-3 file: its arrays with the recipe.
+fn assemble(a: Arrays, parsed: Parsed<'_>) -> MtsModel {
+    MtsModel {
+        positions: parsed.positions,
+        properties: parsed.mesh.properties,
+        strip_records: a.strip_records,
+        strip_begins: a.strip_begins,
+        begin_node: a.begin_node,
+        begin_res: a.begin_res,
+        rec_vertex: a.rec_vertex,
+        rec_label: a.rec_label,
+        rec_code: a.rec_code,
+        far: a.far,
+        slot_size: a.slot_size,
+        band_lod: a.band_lod,
+        band_strips: a.band_strips,
         recipe: super::Recipe {
             strips: parsed.strips,
             collapses: parsed.collapses,
             options: parsed.options,
         },
-    })
+    }
 }
 
 /// The LoD → triangle count table that ends the `MODL` section in `r`
@@ -1015,7 +1066,9 @@ fn read_companions(
     optimal: bool,
 ) -> Result<Vec<Vec<(u32, u32)>>> {
     let mut removed_at = vec![false; vertices];
-    let mut out = Vec::with_capacity(steps.len().min(r.remaining()));
+    // Steps without companions past the last one with some get no list
+    // (a mesh without seams has none at all).
+    let mut out: Vec<Vec<(u32, u32)>> = Vec::new();
     for (i, s) in steps.iter().enumerate() {
         if !optimal {
             // Checked against the earlier steps' companions too.
@@ -1044,7 +1097,10 @@ fn read_companions(
             removed_at[removed] = true;
             moves.push((removed as u32, kept as u32));
         }
-        out.push(moves);
+        if !moves.is_empty() {
+            out.resize_with(i, Vec::new);
+            out.push(moves);
+        }
     }
     r.finish()?;
     Ok(out)
