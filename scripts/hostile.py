@@ -72,7 +72,8 @@ extreme  valid but extreme meshes, and files that are not meshes at all:
 Checksums (read from src/model/format.rs and src/baselines/cluster/stream.rs):
 .mts: header "MTSMODEL" | version u32 | section count u32 | file length u64
 | FNV-1a/64 (offset basis 0xcbf29ce484222325, prime 0x100000001b3) of every
-byte after the 32-byte header, stored at bytes 24..32. Stream: "MTSCT\\0\\0\\x01"
+byte after the 32-byte header (version 3: its four-lane word form,
+checksum::fnv1a64_words), stored at bytes 24..32. Stream: "MTSCT\\0\\0\\x01"
 | vertices, triangles, roots, base triangles (u32 LE each) | FNV-1a/32
 (0x811c9dc5, 0x01000193) of the body after the 28-byte header at bytes
 24..28. Resealing rewrites the length (.mts) and the checksum. Note that
@@ -156,6 +157,25 @@ def fnv1a64(data):
     return h
 
 
+def fnv1a64_words(data):
+    """.mts version 3: FNV-1a's step over little-endian 64-bit words in four
+    lanes (word i to lane i mod 4), lanes folded with the same step, the
+    tail bytes after them with FNV-1a (checksum::fnv1a64_words)."""
+    m = 0xFFFFFFFFFFFFFFFF
+    p = 0x100000001B3
+    lanes = [0xCBF29CE484222325, 0x84222325CBF29CE4, 0x9CE484222325CBF2, 0x2325CBF29CE48422]
+    n = len(data) // 32 * 32
+    words = struct.unpack_from("<%dQ" % (n // 8), data, 0) if n else ()
+    for i, w in enumerate(words):
+        lanes[i & 3] = ((lanes[i & 3] ^ w) * p) & m
+    h = lanes[0]
+    for lane in lanes[1:]:
+        h = ((h ^ lane) * p) & m
+    for b in data[n:]:
+        h = ((h ^ b) * p) & m
+    return h
+
+
 def fnv1a32(data):
     h = 0x811C9DC5
     for b in data:
@@ -174,7 +194,9 @@ def seal_mts(data):
     if len(b) < MTS_HEADER:
         return bytes(b)
     b[16:24] = struct.pack("<Q", len(b))
-    b[24:32] = struct.pack("<Q", fnv1a64(b[MTS_HEADER:]))
+    version = struct.unpack_from("<I", b, 8)[0]
+    body = bytes(b[MTS_HEADER:])
+    b[24:32] = struct.pack("<Q", fnv1a64(body) if version < 3 else fnv1a64_words(body))
     return bytes(b)
 
 
@@ -922,6 +944,11 @@ def gen_mts(rng, seeds, render_ok):
              "strip_range", "strip_other", "short_run", "step_range", "step_self", "step_reuse",
              "step_error", "step_drop", "tag", "section_len", "trailing", "section_extra",
              "version", "section_count", "no_strips", "pos_extreme", "clean"]
+    ready = struct.unpack_from("<I", full, 8)[0] >= 3
+    if ready:
+        # The harness rebuilds only the recipe's sections: byte-level
+        # mutations for the ready file.
+        kinds = ["truncate", "flip", "reseal_flip", "reseal_flip", "reseal_flip", "clean"]
     kind = rng.choice(kinds)
     expect = GARBAGE
     m = MtsFile(full)
@@ -1016,6 +1043,8 @@ def gen_mts(rng, seeds, render_ok):
     else:
         kind = "clean"
         expect = VALID
+        if ready:
+            data = full
     if data is None:
         data = m.to_bytes()
     case = Case("mts", "%s/%s" % (kind, name[:-4]), ".mts", data)
@@ -1378,10 +1407,15 @@ def make_seeds(mts_bin, root, timeout):
     with open(s.obj_path, "wb") as f:
         f.write(obj_text(tp, tf))
     jobs = {
-        "torus.mts": ["build", "--generated", "torus:200", "-o"],
-        "ico_optimal.mts": ["build", "--generated", "icosphere:80", "--optimal", "-o"],
-        "grid_single.mts": ["build", "--generated", "grid:50", "--single-band", "-o"],
-        "cube.mts": ["build", cube, "-o"],
+        # The structured mutations rebuild the recipe (version 1, the
+        # --recipe-only file); the ready files (version 3) get the byte-level
+        # ones.
+        "torus.mts": ["build", "--generated", "torus:200", "--recipe-only", "-o"],
+        "ico_optimal.mts": ["build", "--generated", "icosphere:80", "--optimal", "--recipe-only", "-o"],
+        "grid_single.mts": ["build", "--generated", "grid:50", "--single-band", "--recipe-only", "-o"],
+        "cube.mts": ["build", cube, "--recipe-only", "-o"],
+        "torus_v3.mts": ["build", "--generated", "torus:200", "-o"],
+        "ico_optimal_v3.mts": ["build", "--generated", "icosphere:80", "--optimal", "-o"],
         "torus.stream": ["encode", "--generated", "torus:200", "-o"],
         "ico.stream": ["encode", "--generated", "icosphere:80", "-o"],
         "grid.stream": ["encode", "--generated", "grid:32", "-o"],
@@ -1400,7 +1434,7 @@ def make_seeds(mts_bin, root, timeout):
     for name, data in s.mts.items():
         MtsFile(data)  # the layout is the one this harness knows
         if seal_mts(data) != data:
-            raise RuntimeError("seed %s: resealing changes it; the .mts checksum is not FNV-1a/64" % name)
+            raise RuntimeError("seed %s: resealing changes it; the .mts checksum is not the one of its version" % name)
     for name, data in s.stream.items():
         if seal_stream(data) != data:
             raise RuntimeError("seed %s: resealing changes it; the stream checksum is not FNV-1a/32" % name)

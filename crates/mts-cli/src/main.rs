@@ -914,13 +914,7 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Encode(args) => encode(args),
         Command::Decode(args) => decode(args),
         Command::Compare(args) => compare(args),
-        Command::Verify(args) => {
-            if verify(args)? {
-                Ok(())
-            } else {
-                bail!("the model breaks the invariant (see above)")
-            }
-        }
+        Command::Verify(args) => verify(args),
         Command::Render(args) => render::render(args),
         Command::View(args) => render::view(args),
     }
@@ -1256,7 +1250,7 @@ struct VerifyArgs {
     json: bool,
 }
 
-fn verify(args: &VerifyArgs) -> Result<bool> {
+fn verify(args: &VerifyArgs) -> Result<()> {
     let (name, model) = args.source.model()?;
     let n = match args.lods.as_str() {
         "all" => None,
@@ -1296,7 +1290,14 @@ fn verify(args: &VerifyArgs) -> Result<bool> {
             println!("  first at LoD {lod}: {what}");
         }
     }
-    Ok(report.mismatches == 0)
+    if let Some((lod, what)) = &report.first_mismatch {
+        bail!(
+            "{name}: the model breaks the invariant: {} of {} LoDs mismatch, the first at LoD {lod}: {what}",
+            report.mismatches,
+            report.lods_checked
+        );
+    }
+    Ok(())
 }
 
 fn info(args: &InfoArgs) -> Result<()> {
