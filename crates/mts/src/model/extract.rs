@@ -90,6 +90,18 @@ pub struct Extractor<'m> {
     old_to: Vec<u32>,
 }
 
+/// How much of the coherence cache a LoD change uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// Every strip walked whole (the reference).
+    Scratch,
+    /// Strips whose interval holds the LoD skipped, the others walked whole.
+    Strips,
+    /// As `Strips`, and a changed strip walked only from its changed
+    /// segments.
+    Segments,
+}
+
 /// Result of walking one strip.
 pub(crate) struct Walk {
     pub(crate) len: u32,
@@ -210,8 +222,26 @@ impl<'m> Extractor<'m> {
             }
         }
         let birth = model.band_first_lod(band) as u32;
+        // Within the band, a jump over more than a quarter of its LoDs
+        // changes most segments: strips left valid are still skipped, the
+        // others are walked whole, straight into their slots (the same
+        // bytes; meeting segments would cost more than it saves).
+        let span = (model
+            .band_lod
+            .get(band + 1)
+            .map_or(model.max_lod() + 1, |&l| l as usize))
+            - birth as usize;
+        let near = self
+            .lod
+            .filter(|_| self.band == Some(band))
+            .is_some_and(|old| 4 * old.abs_diff(lod) <= span);
+        let mode = match (coherent, near) {
+            (false, _) => Mode::Scratch,
+            (true, true) => Mode::Segments,
+            (true, false) => Mode::Strips,
+        };
         for s in model.band_strips(band) {
-            if let Some(n) = self.refresh(s, birth, lod as u32, coherent) {
+            if let Some(n) = self.refresh(s, birth, lod as u32, mode) {
                 walked += 1;
                 indices += n;
             }
@@ -226,14 +256,15 @@ impl<'m> Extractor<'m> {
         }
     }
 
-    /// Walks strip `s` at `lod` into its slot unless (when `coherent`) its
-    /// validity interval holds `lod`; when `coherent`, only from its first
-    /// segment that `lod` changes ([`segments`]). Returns the indices it
-    /// walked, if it walked.
-    fn refresh(&mut self, s: usize, birth: u32, lod: u32, coherent: bool) -> Option<usize> {
-        if coherent && self.valid_from[s] <= lod && lod <= self.valid_to[s] {
+    /// Walks strip `s` at `lod` into its slot unless (in the coherent
+    /// modes) its validity interval holds `lod`; in [`Mode::Segments`],
+    /// only from its first segment that `lod` changes ([`segments`]).
+    /// Returns the indices it walked, if it walked.
+    fn refresh(&mut self, s: usize, birth: u32, lod: u32, mode: Mode) -> Option<usize> {
+        if mode != Mode::Scratch && self.valid_from[s] <= lod && lod <= self.valid_to[s] {
             return None;
         }
+        let coherent = mode == Mode::Segments;
         let base = self.seg_base[s] as usize;
         let segs = base..base + self.seg_cap[s] as usize;
         let n = self.seg_len[s] as usize;
