@@ -22,7 +22,7 @@
 //! one extractor per instance. Changing band rewrites the band's region
 //! (one dirty range).
 
-use super::records::{Narrow, Word, BREAK, DISTANCE, FAR, MORE, NO_ARC};
+use super::records::{take_arc, Narrow, Word, BREAK, DISTANCE, FAR};
 use super::segments;
 use super::{MtsModel, END};
 use crate::strip::encode::RESTART_U32;
@@ -523,30 +523,20 @@ fn walk_records<V: Word, L: Word>(
     let code = &model.rec_code[..];
     let mut len = 0usize;
     let mut r = node as usize;
-    'nodes: loop {
+    loop {
         if len >= out.len() {
             w.overflow = true;
             break;
         }
         out[len] = vertex[r].get();
         len += 1;
-        // The node's arcs are this record and the ones its MORE bits chain.
-        let c = loop {
-            let c = code[r];
-            if c == NO_ARC {
-                break 'nodes;
-            }
-            let l = label[r].get();
-            if l >= rel {
-                w.to = w.to.min(birth + l);
-                break c;
-            }
-            w.from = w.from.max(birth + l + 1);
-            if c & MORE == 0 {
-                break 'nodes;
-            }
-            r += 1;
+        let mut interval = (w.from, w.to);
+        let taken = take_arc(code, label, r, rel, birth, &mut interval);
+        (w.from, w.to) = interval;
+        let Some((arc, c)) = taken else {
+            break;
         };
+        r = arc;
         let distance = c & DISTANCE;
         if distance == 0 {
             break;

@@ -117,6 +117,39 @@ impl Word for u32 {
     }
 }
 
+/// The arc a walk takes from the node whose first record is `r`, at LoD
+/// `birth + rel` (Fig. 5 of the paper: the first arc whose label is at
+/// least the LoD): skipped arcs raise `from` past their labels, the taken
+/// one lowers `to` to its label. Returns its record and code, or `None`
+/// when the node has no arc valid there (the strip ends). Shared by every
+/// walk, monomorphised per label width.
+#[inline(always)]
+pub(crate) fn take_arc<L: Word>(
+    code: &[u8],
+    label: &[L],
+    mut r: usize,
+    rel: u32,
+    birth: u32,
+    interval: &mut (u32, u32),
+) -> Option<(usize, u8)> {
+    loop {
+        let c = code[r];
+        if c == NO_ARC {
+            return None;
+        }
+        let l = label[r].get();
+        if l >= rel {
+            interval.1 = interval.1.min(birth + l);
+            return Some((r, c));
+        }
+        interval.0 = interval.0.max(birth + l + 1);
+        if c & MORE == 0 {
+            return None;
+        }
+        r += 1;
+    }
+}
+
 /// The records of every strip, built from the wide graphs the
 /// construction produces (node offsets, vertex per node, arcs with global
 /// node targets and absolute labels).

@@ -29,7 +29,7 @@
 //! walk goes on to the strip's end and lays regular segments again).
 //! Figures: `docs/experiments/coherence.md`.
 
-use super::records::{Word, BREAK, DISTANCE, FAR, MORE, NO_ARC};
+use super::records::{take_arc, Word, BREAK, DISTANCE, FAR};
 use super::{MtsModel, END};
 use crate::strip::encode::RESTART_U32;
 
@@ -250,22 +250,13 @@ pub(crate) fn rewalk<V: Word, L: Word>(
             tmp[t] = v;
         }
         t += 1;
-        let c = loop {
-            let c = code[r];
-            if c == NO_ARC {
-                break 'nodes;
-            }
-            let l = label[r].get();
-            if l >= rel {
-                to = to.min(birth + l);
-                break c;
-            }
-            from = from.max(birth + l + 1);
-            if c & MORE == 0 {
-                break 'nodes;
-            }
-            r += 1;
+        let mut interval = (from, to);
+        let taken = take_arc(code, label, r, rel, birth, &mut interval);
+        (from, to) = interval;
+        let Some((arc, c)) = taken else {
+            break;
         };
+        r = arc;
         let distance = c & DISTANCE;
         if distance == 0 {
             break;
