@@ -22,7 +22,7 @@
 //! one extractor per instance. Changing band rewrites the band's region
 //! (one dirty range).
 
-use super::records::{take_arc, Narrow, Word, BREAK, DISTANCE, FAR};
+use super::records::{step, Narrow, Word};
 use super::segments;
 use super::{MtsModel, END};
 use crate::strip::encode::RESTART_U32;
@@ -531,17 +531,12 @@ fn walk_records<V: Word, L: Word>(
         out[len] = vertex[r].get();
         len += 1;
         let mut interval = (w.from, w.to);
-        let taken = take_arc(code, label, r, rel, birth, &mut interval);
+        let next = step(code, label, &model.far, r, rel, birth, &mut interval);
         (w.from, w.to) = interval;
-        let Some((arc, c)) = taken else {
+        let Some((next, run_break)) = next else {
             break;
         };
-        r = arc;
-        let distance = c & DISTANCE;
-        if distance == 0 {
-            break;
-        }
-        if c & BREAK != 0 {
+        if run_break {
             if len >= out.len() {
                 w.overflow = true;
                 break;
@@ -549,19 +544,8 @@ fn walk_records<V: Word, L: Word>(
             out[len] = RESTART_U32;
             len += 1;
         }
-        r = if distance == FAR {
-            far_target(model, r)
-        } else {
-            r + usize::from(distance)
-        };
+        r = next;
     }
     w.len = len as u32;
     w
-}
-
-/// The target of far arc `r` (the table is checked to hold every far arc).
-#[cold]
-pub(crate) fn far_target(model: &MtsModel, r: usize) -> usize {
-    let i = model.far.partition_point(|&(at, _)| (at as usize) < r);
-    model.far[i].1 as usize
 }

@@ -124,7 +124,7 @@ impl Word for u32 {
 /// when the node has no arc valid there (the strip ends). Shared by every
 /// walk, monomorphised per label width.
 #[inline(always)]
-pub(crate) fn take_arc<L: Word>(
+fn take_arc<L: Word>(
     code: &[u8],
     label: &[L],
     mut r: usize,
@@ -148,6 +148,37 @@ pub(crate) fn take_arc<L: Word>(
         }
         r += 1;
     }
+}
+
+/// One step of a walk from the node whose first record is `r`: the arc
+/// [`take_arc`] takes and where it leads, `Some((the next node's first
+/// record, whether a run break comes before it))`, or `None` where the
+/// strip ends. `far` is the model's table of far arcs.
+#[inline(always)]
+pub(crate) fn step<L: Word>(
+    code: &[u8],
+    label: &[L],
+    far: &[(u32, u32)],
+    r: usize,
+    rel: u32,
+    birth: u32,
+    interval: &mut (u32, u32),
+) -> Option<(usize, bool)> {
+    let (arc, c) = take_arc(code, label, r, rel, birth, interval)?;
+    let next = match c & DISTANCE {
+        0 => return None,
+        FAR => far_target(far, arc),
+        d => arc + usize::from(d),
+    };
+    Some((next, c & BREAK != 0))
+}
+
+/// The target of far arc `r` (validation checks that the table holds every
+/// far arc).
+#[cold]
+fn far_target(far: &[(u32, u32)], r: usize) -> usize {
+    let i = far.partition_point(|&(at, _)| (at as usize) < r);
+    far[i].1 as usize
 }
 
 /// The records of every strip, built from the wide graphs the

@@ -29,7 +29,7 @@
 //! walk goes on to the strip's end and lays regular segments again).
 //! Figures: `docs/experiments/coherence.md`.
 
-use super::records::{take_arc, Word, BREAK, DISTANCE, FAR};
+use super::records::{step, Word};
 use super::{MtsModel, END};
 use crate::strip::encode::RESTART_U32;
 
@@ -251,17 +251,12 @@ pub(crate) fn rewalk<V: Word, L: Word>(
         }
         t += 1;
         let mut interval = (from, to);
-        let taken = take_arc(code, label, r, rel, birth, &mut interval);
+        let next = step(code, label, &model.far, r, rel, birth, &mut interval);
         (from, to) = interval;
-        let Some((arc, c)) = taken else {
+        let Some((next, run_break)) = next else {
             break;
         };
-        r = arc;
-        let distance = c & DISTANCE;
-        if distance == 0 {
-            break;
-        }
-        if c & BREAK != 0 {
+        if run_break {
             if t >= room {
                 overflow = true;
                 break;
@@ -273,11 +268,7 @@ pub(crate) fn rewalk<V: Word, L: Word>(
             }
             t += 1;
         }
-        r = if distance == FAR {
-            super::extract::far_target(model, r)
-        } else {
-            r + usize::from(distance)
-        };
+        r = next;
     }
     finish(segs, k, from, to);
     if !direct {
