@@ -1732,46 +1732,35 @@ fn measure_methods(
 /// the methods without a file reader (multilevel, discrete LoDs).
 fn load_ms_of(method: Method, model: &mts::MtsModel, mesh: &Mesh) -> Result<Option<f64>> {
     use mts::baselines::{cluster, ClusterTree, ProgressiveMesh};
-    const RUNS: usize = 5;
-    Ok(match method {
+    // Median of 5 loads of the same bytes (so an error is every run's).
+    let timed = |mut load: Box<dyn FnMut() -> mts::Result<()> + '_>| -> Result<Option<f64>> {
+        let (results, ms) = median_ms(5, &mut load);
+        results?;
+        Ok(Some(ms))
+    };
+    match method {
         Method::Mts => {
             let bytes = model.to_bytes();
-            let file = std::path::Path::new("model.mts");
-            let mut ok = Ok(());
-            let (_, ms) = median_ms(RUNS, || match mts::MtsModel::from_bytes(&bytes, file) {
-                Ok(m) => std::hint::black_box(mts::Extractor::new(&m).buffer().len()),
-                Err(e) => {
-                    ok = Err(e);
-                    0
-                }
-            });
-            ok?;
-            Some(ms)
+            timed(Box::new(move || {
+                let m = mts::MtsModel::from_bytes(&bytes, std::path::Path::new("model.mts"))?;
+                std::hint::black_box(mts::Extractor::new(&m).buffer().len());
+                Ok(())
+            }))
         }
         Method::Pm => {
             let bytes = ProgressiveMesh::new(mesh, model.collapses())?.to_bytes();
-            let mut ok = Ok(());
-            let (_, ms) = median_ms(RUNS, || {
-                if let Err(e) = ProgressiveMesh::from_bytes(&bytes, "model.pm") {
-                    ok = Err(e);
-                }
-            });
-            ok?;
-            Some(ms)
+            timed(Box::new(move || {
+                ProgressiveMesh::from_bytes(&bytes, "model.pm").map(drop)
+            }))
         }
         Method::Cluster => {
             let bytes = ClusterTree::new(mesh)?.to_stream();
-            let mut ok = Ok(());
-            let (_, ms) = median_ms(RUNS, || {
-                if let Err(e) = cluster::stream::decode(&bytes, "model.stream") {
-                    ok = Err(e);
-                }
-            });
-            ok?;
-            Some(ms)
+            timed(Box::new(move || {
+                cluster::stream::decode(&bytes, "model.stream").map(drop)
+            }))
         }
-        Method::Multilevel | Method::Discrete => None,
-    })
+        Method::Multilevel | Method::Discrete => Ok(None),
+    }
 }
 
 fn compare(args: &CompareArgs) -> Result<()> {

@@ -22,7 +22,7 @@
 //! one extractor per instance. Changing band rewrites the band's region
 //! (one dirty range).
 
-use super::records::{step, Narrow, Word};
+use super::records::{step, with_widths, Narrow, Word};
 use super::segments;
 use super::{MtsModel, END};
 use crate::strip::encode::RESTART_U32;
@@ -51,10 +51,10 @@ pub struct Update {
 pub struct Extractor<'m> {
     model: &'m MtsModel,
     buffer: Vec<u32>,
-    /// Per strip, where its slot starts in its band's region, and how many
-    /// indices the slot holds (its separating restart excluded).
+    /// Per strip, where its slot starts in its band's region (the slot
+    /// holds the model's `slot_size[s]` indices, its separating restart
+    /// excluded).
     slot_start: Vec<u32>,
-    slot_size: Vec<u32>,
     /// Per band, the length of its region (slots and separators).
     band_len: Vec<u32>,
     /// Indices each strip uses now (its run breaks included).
@@ -141,7 +141,6 @@ impl<'m> Extractor<'m> {
             model,
             buffer: vec![RESTART_U32; total],
             slot_start,
-            slot_size: model.slot_size.clone(),
             band_len,
             len: vec![0; strips],
             valid_from: vec![1; strips],
@@ -300,7 +299,7 @@ impl<'m> Extractor<'m> {
         };
         let old_len = self.len[s] as usize;
         let start_at = self.slot_start[s] as usize;
-        let slot = start_at..start_at + self.slot_size[s] as usize;
+        let slot = start_at..start_at + self.model.slot_size[s] as usize;
         let old = segments::Old {
             rec: &self.old_rec[..old_count],
             off: &self.old_off[..old_count],
@@ -322,20 +321,9 @@ impl<'m> Extractor<'m> {
             start,
         };
         let (out, tmp) = (&mut self.buffer[slot], &mut self.tmp[..]);
-        let w = match (&self.model.rec_vertex, &self.model.rec_label) {
-            (Narrow::U16(v), Narrow::U16(l)) => {
-                segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
-            }
-            (Narrow::U16(v), Narrow::U32(l)) => {
-                segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
-            }
-            (Narrow::U32(v), Narrow::U16(l)) => {
-                segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
-            }
-            (Narrow::U32(v), Narrow::U32(l)) => {
-                segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
-            }
-        };
+        let w = with_widths!(&self.model.rec_vertex, &self.model.rec_label, |v, l| {
+            segments::rewalk(&strip, v, l, out, tmp, &mut seg, &old)
+        });
         self.overflows += usize::from(w.overflow);
         self.seg_len[s] = w.segments as u32;
         let (from, to) = segments::interval(
@@ -425,7 +413,6 @@ impl<'m> Extractor<'m> {
     pub fn memory_bytes(&self) -> usize {
         let words = self.buffer.len()
             + self.slot_start.len()
-            + self.slot_size.len()
             + self.band_len.len()
             + self.len.len()
             + self.valid_from.len()
@@ -480,12 +467,9 @@ impl<'m> Extractor<'m> {
 /// `out` (Fig. 5 of the paper), tracking the validity interval: the largest
 /// label skipped bounds it below, the smallest label taken above.
 pub(crate) fn walk(model: &MtsModel, s: usize, birth: u32, lod: u32, out: &mut [u32]) -> Walk {
-    match (&model.rec_vertex, &model.rec_label) {
-        (Narrow::U16(v), Narrow::U16(l)) => walk_records(model, v, l, s, birth, lod, out),
-        (Narrow::U16(v), Narrow::U32(l)) => walk_records(model, v, l, s, birth, lod, out),
-        (Narrow::U32(v), Narrow::U16(l)) => walk_records(model, v, l, s, birth, lod, out),
-        (Narrow::U32(v), Narrow::U32(l)) => walk_records(model, v, l, s, birth, lod, out),
-    }
+    with_widths!(&model.rec_vertex, &model.rec_label, |v, l| {
+        walk_records(model, v, l, s, birth, lod, out)
+    })
 }
 
 fn walk_records<V: Word, L: Word>(

@@ -449,20 +449,9 @@ impl MtsModel {
                 max_lod,
                 vertices,
             };
-            match (&self.rec_vertex, &self.rec_label) {
-                (Narrow::U16(v), Narrow::U16(l)) => {
-                    check_records(&ranges, v, l, &self.rec_code, &mut far)
-                }
-                (Narrow::U16(v), Narrow::U32(l)) => {
-                    check_records(&ranges, v, l, &self.rec_code, &mut far)
-                }
-                (Narrow::U32(v), Narrow::U16(l)) => {
-                    check_records(&ranges, v, l, &self.rec_code, &mut far)
-                }
-                (Narrow::U32(v), Narrow::U32(l)) => {
-                    check_records(&ranges, v, l, &self.rec_code, &mut far)
-                }
-            }
+            records::with_widths!(&self.rec_vertex, &self.rec_label, |v, l| {
+                check_records(&ranges, v, l, &self.rec_code, &mut far)
+            })
             .map_err(|e| format!("strip {s} {e}"))?;
             // The slot: the strip's walk at its band's first LoD has
             // exactly the stored length (a longer one would be cut in its

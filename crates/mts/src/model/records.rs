@@ -97,6 +97,21 @@ impl Narrow {
     }
 }
 
+/// Evaluates `$body` with `$v` and `$l` bound to the vertex and label
+/// arrays of a model at their stored widths, so that the code it calls is
+/// monomorphised per width pair (the walks and the validation).
+macro_rules! with_widths {
+    ($vertex:expr, $label:expr, |$v:ident, $l:ident| $body:expr) => {
+        match ($vertex, $label) {
+            (Narrow::U16($v), Narrow::U16($l)) => $body,
+            (Narrow::U16($v), Narrow::U32($l)) => $body,
+            (Narrow::U32($v), Narrow::U16($l)) => $body,
+            (Narrow::U32($v), Narrow::U32($l)) => $body,
+        }
+    };
+}
+pub(crate) use with_widths;
+
 /// A value read from a [`Narrow`] array inside the walk (monomorphised
 /// per width, so the walk's loop has no width test).
 pub(crate) trait Word: Copy {
