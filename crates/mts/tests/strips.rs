@@ -190,18 +190,43 @@ fn strip_acmr(s: &Strips) -> f64 {
     fifo_acmr(&s.triangles(), s.vertex_count() as usize, CACHE_SIZE)
 }
 
+/// Modelled vertex work of the meshoptimizer-ordered list of `m`: FIFO-16
+/// ACMR and invocations per triangle in batches of 96.
+fn ordered_list_work(m: &Mesh) -> (f64, f64) {
+    use mts::strip::acmr::{fifo_acmr, CACHE_SIZE};
+    use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
+    let list = peers::meshopt::optimize_vertex_cache(&m.triangles, m.vertex_count());
+    let flat: Vec<u32> = list.iter().flatten().copied().collect();
+    (
+        fifo_acmr(&list, m.vertex_count(), CACHE_SIZE),
+        vertex_work(&flat, Topology::List, CacheModel::Batch(96)).per_triangle(),
+    )
+}
+
+/// Invocations per triangle of the strips' restart buffer in batches of 96.
+fn strip_batch96(s: &Strips) -> f64 {
+    use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
+    vertex_work(
+        &s.to_restart_u32(),
+        Topology::StripRestart,
+        CacheModel::Batch(96),
+    )
+    .per_triangle()
+}
+
 #[test]
-fn cache_aware_strips_reuse_more_vertices() {
+fn cache_aware_strips_reuse_as_much_as_an_ordered_list() {
     let cache_aware = StripifyOptions {
         cache_aware: true,
         ..StripifyOptions::default()
     };
     // (mesh, default ACMR, cache-aware ACMR, cache-aware indices per
-    // triangle), to three decimals.
+    // triangle), to three decimals: the rows of seven to eight quads the
+    // pass lays on regular grids.
     let cases = [
-        (generate::grid(60, 40), 1.0, 0.826, 1.325),
-        (generate::torus(100, 50), 1.0, 0.967, 1.355),
-        (generate::icosphere(20, 0.08, 1), 0.997, 0.944, 1.36),
+        (generate::grid(60, 40), 1.0, 0.588, 1.34),
+        (generate::torus(100, 50), 1.0, 0.596, 1.329),
+        (generate::icosphere(20, 0.08, 1), 0.997, 0.601, 1.338),
     ];
     for (m, plain_acmr, acmr, per_triangle) in cases {
         let plain = check(&m, &StripifyOptions::default());
@@ -212,8 +237,64 @@ fn cache_aware_strips_reuse_more_vertices() {
             (r(strip_acmr(&plain)), r(strip_acmr(&ours)), r(ipt)),
             (plain_acmr, acmr, per_triangle)
         );
-        assert!(strip_acmr(&ours) < strip_acmr(&plain));
+        // Fewer vertex transforms than meshoptimizer's cache-ordered list
+        // under both models, with less than half its indices.
+        let (list_fifo, list_batch) = ordered_list_work(&m);
+        assert!(
+            strip_acmr(&ours) < list_fifo,
+            "{} against {list_fifo}",
+            strip_acmr(&ours)
+        );
+        assert!(
+            strip_batch96(&ours) < list_batch,
+            "{} against {list_batch}",
+            strip_batch96(&ours)
+        );
+        assert!(ipt < 1.5, "{ipt}");
     }
+}
+
+/// Every shared model: the cache-aware strips' FIFO-16 ACMR within 0.08 of
+/// the ordered list's (within 0.05 on all but two; measured: 18 of 20, the
+/// largest gap 0.068), their batch-96 work within 0.05 of the list's (below
+/// it on 16), and far fewer indices (docs/experiments/vertex-work.md).
+#[test]
+fn cache_aware_strips_on_shared_models_match_the_ordered_list() {
+    let Some(dir) = common::models_dir() else {
+        return;
+    };
+    let cache_aware = StripifyOptions {
+        cache_aware: true,
+        ..StripifyOptions::default()
+    };
+    let mut within = 0;
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if !matches!(
+            path.extension().and_then(|e| e.to_str()),
+            Some("obj" | "ply")
+        ) {
+            continue;
+        }
+        let (m, _) = load(&path, LoadOptions::default()).unwrap();
+        let ours = check(&m, &cache_aware);
+        let (list_fifo, list_batch) = ordered_list_work(&m);
+        let gap = strip_acmr(&ours) - list_fifo;
+        assert!(gap <= 0.08, "{}: FIFO-16 gap {gap}", path.display());
+        let batch_gap = strip_batch96(&ours) - list_batch;
+        assert!(
+            batch_gap <= 0.05,
+            "{}: batch-96 gap {batch_gap}",
+            path.display()
+        );
+        let ipt = ours.restart_index_count() as f64 / ours.triangle_count() as f64;
+        assert!(ipt < 2.0, "{}: {ipt} indices per triangle", path.display());
+        within += usize::from(gap <= 0.05);
+        seen += 1;
+    }
+    assert!(seen >= 20, "{seen} models in {}", dir.display());
+    assert!(within + 2 >= seen, "{within} of {seen} within +0.05");
 }
 
 fn random_mesh() -> impl Strategy<Value = Mesh> {

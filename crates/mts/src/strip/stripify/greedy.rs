@@ -7,7 +7,6 @@
 //! side allows it, and when it cannot go on it grows again from its start in
 //! the other direction.
 
-use super::cache::VertexFifo;
 use super::path::{pivot, slot_to};
 use crate::mesh::{TriangleAdjacency, NO_NEIGHBOUR};
 
@@ -91,82 +90,96 @@ impl<'a> Walk<'a> {
     /// The candidate score is the candidate's free-neighbour count plus the
     /// swap penalty if entering it needs a swap (see the `path` module:
     /// a swap is three consecutive shared edges around one vertex).
-    ///
-    /// With a `cache` (the cache-aware pass), a candidate whose new vertex
-    /// is cached scores [`VertexFifo::HIT_BONUS`] less, each new vertex goes
-    /// through the cache, and growth stops where [`VertexFifo::step`] says.
-    pub(super) fn grow_back(&mut self, path: &mut Vec<u32>, mut cache: Option<&mut VertexFifo>) {
-        let n = path.len();
-        let mut cur = path[n - 1];
-        // Entry slot of `cur`, carried from step to step.
-        let mut entry = (n >= 2).then(|| slot_to(self.adj, cur, path[n - 2]));
-        // Where the pivot at the previous triangle lies in `cur`: the start
-        // or the end of the entry edge (slot `entry` or `entry + 1`), or
-        // neither. A swap is needed when the pivot at `cur` is that vertex.
-        // Positions instead of vertex ids keep the loop off the triangle
-        // array (one cache miss fewer per step; vertices and positions
-        // correspond one to one in a non-degenerate triangle).
-        let mut pivot_at = if n >= 3 {
-            let prev = path[n - 2];
-            let a = slot_to(self.adj, prev, path[n - 3]);
-            let b = slot_to(self.adj, prev, cur);
-            let p = pivot(&self.tris[prev as usize], a, b);
-            self.tris[cur as usize].iter().position(|&v| v == p)
-        } else {
-            None
-        };
+    pub(super) fn grow_back(&mut self, path: &mut Vec<u32>) {
+        let mut cursor = Cursor::at_back(self, path);
         loop {
-            let ns = &self.adj.neighbours[cur as usize];
+            let ns = &self.adj.neighbours[cursor.cur as usize];
             let mut best: Option<(f32, usize)> = None;
             for (s, &cand) in ns.iter().enumerate() {
-                if Some(s) == entry || !self.is_free(cand) {
+                if Some(s) == cursor.entry || !self.is_free(cand) {
                     continue;
                 }
-                let swap = match (entry, pivot_at) {
-                    (Some(e), Some(p)) => pivot_slot(e, s) == p,
-                    _ => false,
-                };
-                let mut score = f32::from(self.free_deg[cand as usize])
-                    + if swap { self.swap_penalty } else { 0.0 };
-                if let Some(c) = cache.as_deref() {
-                    if c.holds(apex(self.tris, self.adj, cur, s)) {
-                        score -= VertexFifo::HIT_BONUS;
-                    }
-                }
+                let score = f32::from(self.free_deg[cand as usize])
+                    + if cursor.swaps_through(s) {
+                        self.swap_penalty
+                    } else {
+                        0.0
+                    };
                 if best.is_none_or(|(b, _)| score < b) {
                     best = Some((score, s));
                 }
             }
             let Some((_, s)) = best else { return };
-            let next = ns[s];
-            let next_entry = self.adj.mate(cur, s);
-            // Exit edge `s` is `next`'s edge `next_entry` reversed: its
-            // start is at `next_entry + 1`, its end at `next_entry`.
-            pivot_at = entry.map(|e| {
-                if pivot_slot(e, s) == s {
-                    (next_entry + 1) % 3
-                } else {
-                    next_entry
-                }
-            });
-            entry = Some(next_entry);
+            let next = cursor.advance(self.adj, s);
             self.take(next);
             path.push(next);
-            if let Some(c) = cache.as_deref_mut() {
-                if c.step(self.tris[next as usize][(next_entry + 2) % 3]) {
-                    return;
-                }
-            }
-            cur = next;
         }
     }
 }
 
-/// The vertex of `cur`'s neighbour across slot `s` that is not on their
-/// shared edge.
-fn apex(tris: &[[u32; 3]], adj: &TriangleAdjacency, cur: u32, s: usize) -> u32 {
-    let next = adj.neighbours[cur as usize][s];
-    tris[next as usize][(adj.mate(cur, s) + 2) % 3]
+/// The back of a growing path: its last triangle and what deciding the
+/// next one's swap needs.
+pub(super) struct Cursor {
+    /// The path's last triangle.
+    pub(super) cur: u32,
+    /// Slot of `cur` it was entered through (none for a path of one).
+    pub(super) entry: Option<usize>,
+    /// Where the pivot at the previous triangle lies in `cur`: the start
+    /// or the end of the entry edge (slot `entry` or `entry + 1`), or
+    /// neither. A swap is needed when the pivot at `cur` is that vertex.
+    /// Positions instead of vertex ids keep the loop off the triangle
+    /// array (one cache miss fewer per step; vertices and positions
+    /// correspond one to one in a non-degenerate triangle).
+    pivot_at: Option<usize>,
+}
+
+impl Cursor {
+    /// The cursor at the back of `path` (not empty).
+    pub(super) fn at_back(walk: &Walk<'_>, path: &[u32]) -> Cursor {
+        let n = path.len();
+        let cur = path[n - 1];
+        let entry = (n >= 2).then(|| slot_to(walk.adj, cur, path[n - 2]));
+        let pivot_at = if n >= 3 {
+            let prev = path[n - 2];
+            let a = slot_to(walk.adj, prev, path[n - 3]);
+            let b = slot_to(walk.adj, prev, cur);
+            let p = pivot(&walk.tris[prev as usize], a, b);
+            walk.tris[cur as usize].iter().position(|&v| v == p)
+        } else {
+            None
+        };
+        Cursor {
+            cur,
+            entry,
+            pivot_at,
+        }
+    }
+
+    /// Whether leaving `cur` through slot `s` costs a swap.
+    pub(super) fn swaps_through(&self, s: usize) -> bool {
+        match (self.entry, self.pivot_at) {
+            (Some(e), Some(p)) => pivot_slot(e, s) == p,
+            _ => false,
+        }
+    }
+
+    /// Moves to `cur`'s neighbour through slot `s` and returns it.
+    pub(super) fn advance(&mut self, adj: &TriangleAdjacency, s: usize) -> u32 {
+        let next = adj.neighbours[self.cur as usize][s];
+        let next_entry = adj.mate(self.cur, s);
+        // Exit edge `s` is `next`'s edge `next_entry` reversed: its
+        // start is at `next_entry + 1`, its end at `next_entry`.
+        self.pivot_at = self.entry.map(|e| {
+            if pivot_slot(e, s) == s {
+                (next_entry + 1) % 3
+            } else {
+                next_entry
+            }
+        });
+        self.entry = Some(next_entry);
+        self.cur = next;
+        next
+    }
 }
 
 /// The position in a triangle of the vertex shared by its edge slots `a`
@@ -186,9 +199,9 @@ pub(super) fn strip_rest(walk: &mut Walk<'_>, paths: &mut Vec<Vec<u32>>) {
     while let Some(start) = walk.pop_start() {
         walk.take(start);
         let mut path = vec![start];
-        walk.grow_back(&mut path, None);
+        walk.grow_back(&mut path);
         path.reverse();
-        walk.grow_back(&mut path, None);
+        walk.grow_back(&mut path);
         paths.push(path);
     }
 }

@@ -377,8 +377,8 @@ pub(super) fn strip_patches(
     super::path::join_ends(&mut rows, walk.adj);
     paths.extend(rows);
     for path in &mut paths[first_row..] {
-        walk.grow_back(path, None);
+        walk.grow_back(path);
         path.reverse();
-        walk.grow_back(path, None);
+        walk.grow_back(path);
     }
 }
