@@ -7,7 +7,7 @@ use super::MeshSource;
 use crate::results::{ModelFit, Scene, VertexRow, VertexWork};
 use anyhow::Result;
 use clap::Args;
-use mts::{peers, Extractor};
+use mts::{peers, Extractor, StripifyOptions};
 use mts_render::headless::HeadlessTarget;
 use mts_render::{Camera, Gpu, RendererConfig, StripRenderer};
 use serde::Serialize;
@@ -81,9 +81,12 @@ struct RenderRow {
 const VERTEX_SHARES: [f64; 4] = [1.0, 0.5, 0.1, 0.01];
 
 /// Measures [`VertexWork`] of `model` on `gpu`: MTS strips (restart or
-/// stitched, as the backend draws), meshoptimizer's strips, the
-/// meshoptimizer-ordered list and the unordered list (the oracle's order)
-/// at each of [`VERTEX_SHARES`], and the baselines' lists (`pm_list`,
+/// stitched, as the backend draws), the MTS strips of the same model built
+/// with cache-aware bands (`mts_cache_aware`), meshoptimizer's strips, the
+/// cache-aware stripifier on the level's triangles (`cache_aware_strips`,
+/// and stitched into one run: `cache_aware_stitched`),
+/// the meshoptimizer-ordered list and the unordered list (the oracle's
+/// order) at each of [`VERTEX_SHARES`], and the baselines' lists (`pm_list`,
 /// `multilevel_list`, `cluster_list`, `discrete_list`; discrete where
 /// meshoptimizer takes the mesh) at their finest LoD within the same
 /// triangles.
@@ -104,6 +107,21 @@ pub fn measure_vertex_work(
     let mut renderer = StripRenderer::for_model(d, q, config, model)?;
     renderer.set_camera(q, camera);
     let mut ex = Extractor::new(model);
+    // The same sequence and band slack, every band stripified cache-aware.
+    let aware = StripifyOptions {
+        cache_aware: true,
+        ..StripifyOptions::default()
+    };
+    let aware_model = mts::model::build(
+        &mesh,
+        &mts::stripify(&mesh, &aware),
+        model.collapses(),
+        &mts::model::BuildOptions {
+            band_slack: model.build_options().band_slack,
+            stripify: aware,
+        },
+    );
+    let mut aware_ex = Extractor::new(&aware_model);
     let mut rows = Vec::new();
     for ratio in VERTEX_SHARES {
         let lod = model.lod_for_ratio(ratio);
@@ -117,11 +135,26 @@ pub fn measure_vertex_work(
             properties: Default::default(),
         };
         let theirs = peers::meshopt::stripify(&level).to_restart_u32();
+        let aware_strips = mts::stripify(&level, &aware).to_restart_u32();
+        // The same runs joined by degenerate triangles instead of restart
+        // values: a driver that empties its vertex cache at each restart
+        // keeps it across the joins.
+        let mut aware_stitched = Vec::new();
+        stitch_restart_buffer(&aware_strips, &mut aware_stitched);
         let ours = ex.buffer()[ex.active_range()].to_vec();
+        aware_ex.set_lod(lod);
+        let ours_aware = aware_ex.buffer()[aware_ex.active_range()].to_vec();
         let flat = |t: &[[u32; 3]]| t.iter().flatten().copied().collect::<Vec<u32>>();
         for (method, buffer, topology) in [
             ("mts_strips", ours, Topology::StripRestart),
+            ("mts_cache_aware", ours_aware, Topology::StripRestart),
             ("meshopt_strips", theirs, Topology::StripRestart),
+            ("cache_aware_strips", aware_strips, Topology::StripRestart),
+            (
+                "cache_aware_stitched",
+                aware_stitched,
+                Topology::StripRestart,
+            ),
             ("meshopt_list", flat(&ordered), Topology::List),
             ("list", flat(&oracle), Topology::List),
         ] {

@@ -215,17 +215,17 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
         // triangles drawn or the primitives assembled.
         match &r.vertex_work {
             Some(w) => {
-                // Four methods and four (or, without discrete, three)
+                // Seven methods and four (or, without discrete, three)
                 // baselines at four shares.
                 need(
-                    w.rows.len() == 32 || w.rows.len() == 28,
-                    format!("vertex work: {} rows, not 32 (or 28)", w.rows.len()),
+                    w.rows.len() == 44 || w.rows.len() == 40,
+                    format!("vertex work: {} rows, not 44 (or 40)", w.rows.len()),
                 );
                 for row in &w.rows {
                     let at = format!("vertex work {} at {}", row.method, row.ratio);
                     need(
                         row.vertex_invocations.is_some() == w.pipeline_statistics
-                            && row.modelled.len() == 4,
+                            && row.modelled.len() == mts::strip::vertex_work::REPORTED_MODELS.len(),
                         format!("{at}: measured or modelled counts missing"),
                     );
                     if let Some(c) = row.clipper_invocations {

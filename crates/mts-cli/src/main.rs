@@ -618,6 +618,7 @@ fn stats_json(s: &StripStats) -> serde_json::Value {
     v["acmr_batch96"] = json!(s.acmr_batch96);
     v["acmr_batch384"] = json!(s.acmr_batch384);
     v["acmr_lru32"] = json!(s.acmr_lru32);
+    v["acmr_lru32_run"] = json!(s.acmr_lru32_run);
     v
 }
 
@@ -697,7 +698,7 @@ fn strips(args: &StripsArgs) -> Result<()> {
     let peer = peer.unwrap_or_default();
     // Each row: its label and the figure of a side.
     type Figure = fn(&StripStats) -> String;
-    let rows: [(&str, Figure); 10] = [
+    let rows: [(&str, Figure); 11] = [
         ("triangles", |s| s.triangles.to_string()),
         ("strips", |s| s.strips.to_string()),
         ("swaps", |s| s.swaps.to_string()),
@@ -709,6 +710,9 @@ fn strips(args: &StripsArgs) -> Result<()> {
         ("ACMR (batch 96)", |s| format!("{:.3}", s.acmr_batch96)),
         ("ACMR (batch 384)", |s| format!("{:.3}", s.acmr_batch384)),
         ("ACMR (LRU 32)", |s| format!("{:.3}", s.acmr_lru32)),
+        ("ACMR (LRU 32 per run)", |s| {
+            format!("{:.3}", s.acmr_lru32_run)
+        }),
         ("ms (median)", |s| format!("{:.2}", s.ms)),
     ];
     for (label, figure) in rows {

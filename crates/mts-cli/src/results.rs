@@ -123,6 +123,9 @@ pub struct StripRow {
     pub indices_restart: u64,
     pub indices_per_triangle: f64,
     pub acmr: f64,
+    /// Modelled invocations per triangle of the restart buffer in batches
+    /// of 96 indices.
+    pub acmr_batch96: f64,
     pub ms: f64,
 }
 
@@ -135,6 +138,7 @@ impl From<&mts::strip::stats::StripStats> for StripRow {
             indices_restart: s.indices_restart as u64,
             indices_per_triangle: s.indices_per_triangle,
             acmr: s.acmr,
+            acmr_batch96: s.acmr_batch96,
             ms: s.ms,
         }
     }
@@ -146,6 +150,12 @@ pub struct Stripify {
     #[serde(flatten)]
     pub mts: StripRow,
     pub meshopt: StripRow,
+    /// The cache-aware option (`mts strips --cache-aware`).
+    pub cache_aware: StripRow,
+    /// FIFO-16 ACMR of the meshoptimizer-ordered triangle list.
+    pub list_acmr: f64,
+    /// Its invocations per triangle in batches of 96 indices.
+    pub list_acmr_batch96: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -401,7 +411,8 @@ pub struct VertexRow {
     pub lod: u64,
     /// Non-degenerate triangles drawn.
     pub triangles: u64,
-    /// `mts_strips`, `meshopt_strips`, `meshopt_list`, `list`.
+    /// `mts_strips`, `mts_cache_aware`, `meshopt_strips`,
+    /// `cache_aware_strips`, `meshopt_list`, `list`, or a baseline's list.
     pub method: String,
     /// Indices in the drawn buffer (restart values or stitching included).
     pub indices_sent: u64,

@@ -27,6 +27,9 @@ pub struct StripStats {
     pub acmr_batch384: f64,
     /// The same through a 32-entry LRU cache.
     pub acmr_lru32: f64,
+    /// The same through a 32-entry LRU cache emptied at every restart (the
+    /// model that fits Mesa's lavapipe: see [`CacheModel::LruPerRun`]).
+    pub acmr_lru32_run: f64,
     /// Milliseconds the stripifier took.
     pub ms: f64,
 }
@@ -54,6 +57,7 @@ impl StripStats {
             acmr_batch96: per_triangle(CacheModel::Batch(96)),
             acmr_batch384: per_triangle(CacheModel::Batch(384)),
             acmr_lru32: per_triangle(CacheModel::Lru(32)),
+            acmr_lru32_run: per_triangle(CacheModel::LruPerRun(32)),
             ms,
         }
     }
