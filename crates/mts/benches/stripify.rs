@@ -1,7 +1,7 @@
 //! Stripification speed: the project's stripifier against meshoptimizer's
 //! (`optimize_vertex_cache_strip` + `stripify`) on generated meshes of three
 //! sizes (to show linear growth) and on the bunny when `../shared/models`
-//! is present.
+//! is present; the cache-aware option (`mts-cache-aware`) beside them.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mts::mesh::generate::Generated;
@@ -40,6 +40,13 @@ fn bench(c: &mut Criterion) {
         });
         group.bench_with_input(BenchmarkId::new("meshopt", &name), &mesh, |b, m| {
             b.iter(|| black_box(peers::meshopt::stripify(m)))
+        });
+        let aware = StripifyOptions {
+            cache_aware: true,
+            ..StripifyOptions::default()
+        };
+        group.bench_with_input(BenchmarkId::new("mts-cache-aware", &name), &mesh, |b, m| {
+            b.iter(|| black_box(stripify(m, &aware)))
         });
     }
     group.finish();
