@@ -142,7 +142,7 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
             .collect();
         let count = |f: fn(&(bool, bool, bool)) -> bool| verdicts.iter().filter(|v| f(v)).count();
         let (i, f, b) = (count(|v| v.0), count(|v| v.1), count(|v| v.2));
-        let gap =
+        let largest =
             |g: fn(&Model) -> f64| files.iter().map(|m| g(m)).fold(f64::NEG_INFINITY, f64::max);
         row(
             s,
@@ -150,10 +150,10 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
             "all three on every model",
             format!(
                 "indices below on {i} of {n} (highest ratio {:.3}); FIFO 16 within on {f} (largest gap {:+.3}); batch 96 within on {b} (largest gap {:+.3})",
-                gap(|m| m.stripify.cache_aware.indices_per_triangle
+                largest(|m| m.stripify.cache_aware.indices_per_triangle
                     / m.stripify.meshopt.indices_per_triangle),
-                gap(|m| m.stripify.cache_aware.acmr - m.stripify.list_acmr),
-                gap(|m| m.stripify.cache_aware.acmr_batch96 - m.stripify.list_acmr_batch96),
+                largest(|m| m.stripify.cache_aware.acmr - m.stripify.list_acmr),
+                largest(|m| m.stripify.cache_aware.acmr_batch96 - m.stripify.list_acmr_batch96),
             ),
             i == n && f == n && b == n,
         );

@@ -225,6 +225,16 @@ impl Rows<'_, '_> {
         }
     }
 
+    /// Takes `cursor`'s neighbour through slot `s` into `path` and records
+    /// its new vertex.
+    fn extend(&mut self, cursor: &mut Cursor, s: usize, path: &mut Vec<u32>) {
+        let v = self.walk.apex(cursor.cur, s);
+        let n = cursor.advance(self.walk.adj, s);
+        self.walk.take(n);
+        self.record(v);
+        path.push(n);
+    }
+
     /// Whether meeting `v` would pass the row's limits.
     fn over(&self, v: u32) -> bool {
         let new = self.in_chain[v as usize] != self.row && self.in_next[v as usize] != self.row;
@@ -311,16 +321,11 @@ impl Rows<'_, '_> {
             let Some((_, s)) = best else {
                 return (path, i, End::Blocked);
             };
-            let walk = &*self.walk;
-            let n = walk.adj.neighbours[cursor.cur as usize][s];
-            let v = walk.tris[n as usize][(walk.adj.mate(cursor.cur, s) + 2) % 3];
+            let v = self.walk.apex(cursor.cur, s);
             if self.over(v) {
                 return (path, i, End::Full);
             }
-            cursor.advance(walk.adj, s);
-            self.walk.take(n);
-            self.record(v);
-            path.push(n);
+            self.extend(&mut cursor, s, &mut path);
         }
     }
 
@@ -338,7 +343,7 @@ impl Rows<'_, '_> {
                 if Some(s) == cursor.entry || !walk.is_free(n) {
                     continue;
                 }
-                let v = walk.tris[n as usize][(walk.adj.mate(cursor.cur, s) + 2) % 3];
+                let v = walk.apex(cursor.cur, s);
                 let key = (
                     cursor.swaps_through(s),
                     !self.fifo.holds(v),
@@ -352,16 +357,11 @@ impl Rows<'_, '_> {
                 self.record_start(start, best.map(|(_, s)| s));
             }
             let Some((_, s)) = best else { return path };
-            let walk = &*self.walk;
-            let n = ns[s];
-            let v = walk.tris[n as usize][(walk.adj.mate(cursor.cur, s) + 2) % 3];
+            let v = self.walk.apex(cursor.cur, s);
             if !self.fifo.holds(v) && self.fifo.now - self.row_since >= FIRST_MISSES {
                 return path;
             }
-            cursor.advance(walk.adj, s);
-            self.walk.take(n);
-            self.record(v);
-            path.push(n);
+            self.extend(&mut cursor, s, &mut path);
         }
     }
 

@@ -72,6 +72,13 @@ impl<'a> Walk<'a> {
         }
     }
 
+    /// The vertex of `t`'s neighbour through slot `s` that is not on their
+    /// shared edge.
+    pub(super) fn apex(&self, t: u32, s: usize) -> u32 {
+        let n = self.adj.neighbours[t as usize][s];
+        self.tris[n as usize][(self.adj.mate(t, s) + 2) % 3]
+    }
+
     /// The free triangle with fewest free neighbours; the most recently
     /// updated one on a tie, which keeps new strips next to the last.
     pub(super) fn pop_start(&mut self) -> Option<u32> {
