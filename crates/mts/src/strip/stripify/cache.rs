@@ -15,9 +15,9 @@
 //! order: it turns around a chain vertex (the pivot) until it reaches the
 //! triangle that holds the next chain vertex, then turns around that one,
 //! so every triangle of the row touches the last row. Before the chain's
-//! first edge it takes the first vertex's whole free fan: a row that starts
-//! at the edge leaves a triangle behind per row where the quads' diagonals
-//! lean the other way. The vertices the row meets off the chain, in order,
+//! first edge it takes the first vertex's free fan (up to
+//! [`MAX_BACK_FAN`] triangles): a row that starts at the edge leaves a
+//! triangle behind per row where the quads' diagonals lean the other way. The vertices the row meets off the chain, in order,
 //! are the next row's chain, walked the same way: a vertex then comes back
 //! about one row's misses after it entered the cache, whatever its place in
 //! the row (a row walked the other way, a serpentine, meets the last row's
@@ -47,6 +47,11 @@ const ROW_NEW: usize = 8;
 /// Cache misses after which a row stops (the new vertices plus the last
 /// row's vertices the cache had already dropped).
 const ROW_MISSES: u32 = 10;
+/// Most free triangles a row's first strip takes around its first chain
+/// vertex before the chain's first edge. Every shared model gives the same
+/// strips with 8 as with no limit (4 loses two models' FIFO figure); the
+/// bound keeps a strip's start O(1) at a vertex with thousands of triangles.
+const MAX_BACK_FAN: usize = 8;
 /// Cache misses after which the first strip of a band stops: its chain is
 /// half its vertices, which the next row meets while at most about
 /// [`CACHE_SIZE`] misses came after them.
@@ -259,9 +264,9 @@ impl Rows<'_, '_> {
                 .expect("a row starts a strip at a vertex with a free triangle"),
         };
         // Turn back around `c`, away from the next chain vertex, while the
-        // fan is free (at most once around it).
+        // fan is free (at most once around it, and at most MAX_BACK_FAN).
         let mut from = chain.get(i + 1).copied();
-        for _ in 0..fan.len() {
+        for _ in 0..fan.len().min(MAX_BACK_FAN) {
             let tri = walk.tris[start as usize];
             let k = tri.iter().position(|&v| v == c).expect("c is in its fan");
             let (s, far) = if Some(tri[(k + 1) % 3]) == from {
