@@ -81,7 +81,7 @@ struct RenderRow {
 const VERTEX_SHARES: [f64; 4] = [1.0, 0.5, 0.1, 0.01];
 
 /// Measures [`VertexWork`] of `model` on `gpu`: MTS strips (restart or
-/// stitched, as the backend draws), the MTS strips of the same model built
+/// stitched, as the backend draws; and stitched: `mts_stitched`), the MTS strips of the same model built
 /// with cache-aware bands (`mts_cache_aware`), meshoptimizer's strips, the
 /// cache-aware stripifier on the level's triangles (`cache_aware_strips`,
 /// and stitched into one run: `cache_aware_stitched`),
@@ -142,11 +142,14 @@ pub fn measure_vertex_work(
         let mut aware_stitched = Vec::new();
         stitch_restart_buffer(&aware_strips, &mut aware_stitched);
         let ours = ex.buffer()[ex.active_range()].to_vec();
+        let mut ours_stitched = Vec::new();
+        stitch_restart_buffer(&ours, &mut ours_stitched);
         aware_ex.set_lod(lod);
         let ours_aware = aware_ex.buffer()[aware_ex.active_range()].to_vec();
         let flat = |t: &[[u32; 3]]| t.iter().flatten().copied().collect::<Vec<u32>>();
         for (method, buffer, topology) in [
             ("mts_strips", ours, Topology::StripRestart),
+            ("mts_stitched", ours_stitched, Topology::StripRestart),
             ("mts_cache_aware", ours_aware, Topology::StripRestart),
             ("meshopt_strips", theirs, Topology::StripRestart),
             ("cache_aware_strips", aware_strips, Topology::StripRestart),

@@ -215,11 +215,11 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
         // triangles drawn or the primitives assembled.
         match &r.vertex_work {
             Some(w) => {
-                // Seven methods and four (or, without discrete, three)
+                // Eight methods and four (or, without discrete, three)
                 // baselines at four shares.
                 need(
-                    w.rows.len() == 44 || w.rows.len() == 40,
-                    format!("vertex work: {} rows, not 44 (or 40)", w.rows.len()),
+                    w.rows.len() == 48 || w.rows.len() == 44,
+                    format!("vertex work: {} rows, not 48 (or 44)", w.rows.len()),
                 );
                 for row in &w.rows {
                     let at = format!("vertex work {} at {}", row.method, row.ratio);
