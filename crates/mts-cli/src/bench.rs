@@ -614,7 +614,6 @@ fn interleaved_ms<A, B>(
 /// cache-aware option beside them, and the modelled vertex work of the
 /// meshoptimizer-ordered list it competes with.
 fn measure_stripify(mesh: &Mesh, repeat: usize) -> Stripify {
-    use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
     let options = StripifyOptions::default();
     let ((ours, ms), (theirs, their_ms)) = interleaved_ms(
         repeat,
@@ -630,17 +629,14 @@ fn measure_stripify(mesh: &Mesh, repeat: usize) -> Stripify {
         || mts::stripify(mesh, &cache_aware),
         || peers::meshopt::optimize_vertex_cache(&mesh.triangles, mesh.vertex_count()),
     );
-    let flat: Vec<u32> = list.iter().flatten().copied().collect();
+    let (list_acmr, list_acmr_batch96) =
+        mts::strip::vertex_work::list_fifo16_batch96(&list, mesh.vertex_count());
     Stripify {
         mts: StripRow::from(&StripStats::new(&ours, ms)),
         meshopt: StripRow::from(&StripStats::new(&theirs, their_ms)),
         cache_aware: StripRow::from(&StripStats::new(&aware, aware_ms)),
-        list_acmr: mts::strip::acmr::fifo_acmr(
-            &list,
-            mesh.vertex_count(),
-            mts::strip::acmr::CACHE_SIZE,
-        ),
-        list_acmr_batch96: vertex_work(&flat, Topology::List, CacheModel::Batch(96)).per_triangle(),
+        list_acmr,
+        list_acmr_batch96,
     }
 }
 

@@ -626,18 +626,9 @@ fn stats_json(s: &StripStats) -> serde_json::Value {
 /// meshoptimizer-ordered triangle list of `mesh`: the list strips compete
 /// with.
 fn list_acmr_json(mesh: &Mesh) -> (serde_json::Value, serde_json::Value) {
-    use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
     let list = peers::meshopt::optimize_vertex_cache(&mesh.triangles, mesh.vertex_count());
-    let flat: Vec<u32> = list.iter().flatten().copied().collect();
-    let per_triangle = |model| vertex_work(&flat, Topology::List, model).per_triangle();
-    (
-        json!(mts::strip::acmr::fifo_acmr(
-            &list,
-            mesh.vertex_count(),
-            mts::strip::acmr::CACHE_SIZE
-        )),
-        json!(per_triangle(CacheModel::Batch(96))),
-    )
+    let (fifo, batch96) = mts::strip::vertex_work::list_fifo16_batch96(&list, mesh.vertex_count());
+    (json!(fifo), json!(batch96))
 }
 
 fn strips(args: &StripsArgs) -> Result<()> {

@@ -11,7 +11,7 @@
 
 use mts::mesh::io::{load, LoadOptions};
 use mts::strip::stats::StripStats;
-use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
+use mts::strip::vertex_work::list_fifo16_batch96;
 use mts::{peers, stripify, StripifyOptions};
 use std::path::Path;
 
@@ -49,10 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let ours = StripStats::new(&stripify(&mesh, &options), 0.0);
         let theirs = StripStats::new(&peers::meshopt::stripify(&mesh), 0.0);
         let list = peers::meshopt::optimize_vertex_cache(&mesh.triangles, mesh.vertex_count());
-        let flat: Vec<u32> = list.iter().flatten().copied().collect();
-        let list_fifo =
-            mts::strip::acmr::fifo_acmr(&list, mesh.vertex_count(), mts::strip::acmr::CACHE_SIZE);
-        let list_b96 = vertex_work(&flat, Topology::List, CacheModel::Batch(96)).per_triangle();
+        let (list_fifo, list_b96) = list_fifo16_batch96(&list, mesh.vertex_count());
         let mut fan = vec![0i64; mesh.vertex_count()];
         for &v in mesh.triangles.iter().flatten() {
             fan[v as usize] += 1;

@@ -193,14 +193,8 @@ fn strip_acmr(s: &Strips) -> f64 {
 /// Modelled vertex work of the meshoptimizer-ordered list of `m`: FIFO-16
 /// ACMR and invocations per triangle in batches of 96.
 fn ordered_list_work(m: &Mesh) -> (f64, f64) {
-    use mts::strip::acmr::{fifo_acmr, CACHE_SIZE};
-    use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
     let list = peers::meshopt::optimize_vertex_cache(&m.triangles, m.vertex_count());
-    let flat: Vec<u32> = list.iter().flatten().copied().collect();
-    (
-        fifo_acmr(&list, m.vertex_count(), CACHE_SIZE),
-        vertex_work(&flat, Topology::List, CacheModel::Batch(96)).per_triangle(),
-    )
+    mts::strip::vertex_work::list_fifo16_batch96(&list, m.vertex_count())
 }
 
 /// Invocations per triangle of the strips' restart buffer in batches of 96.

@@ -59,7 +59,7 @@ const FIRST_MISSES: u32 = 14;
 
 /// A FIFO of the last [`CACHE_SIZE`] distinct vertices missed, as
 /// [`crate::strip::acmr::fifo_acmr`] models it.
-pub(super) struct VertexFifo {
+struct VertexFifo {
     /// When each vertex last entered the cache, in misses (0: never).
     stamp: Vec<u32>,
     /// Misses so far, plus `CACHE_SIZE + 1` so that stamp 0 is never held.
@@ -85,20 +85,17 @@ impl VertexFifo {
     }
 
     /// Whether `v` is cached.
-    pub(super) fn holds(&self, v: u32) -> bool {
+    fn holds(&self, v: u32) -> bool {
         self.age(v).is_some()
     }
 
-    /// References `v`: a miss enters it (pushing out the oldest). Returns
-    /// whether it was a hit.
-    fn touch(&mut self, v: u32) -> bool {
-        if self.holds(v) {
-            return true;
+    /// References `v`: a miss enters it (pushing out the oldest).
+    fn touch(&mut self, v: u32) {
+        if !self.holds(v) {
+            self.stamp[v as usize] = self.now;
+            self.ring[(self.now % CACHE_SIZE) as usize] = v;
+            self.now += 1;
         }
-        self.stamp[v as usize] = self.now;
-        self.ring[(self.now % CACHE_SIZE) as usize] = v;
-        self.now += 1;
-        false
     }
 }
 
