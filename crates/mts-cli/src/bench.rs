@@ -1402,8 +1402,10 @@ pub fn write(dir: &Path, results: &Results) -> Result<()> {
     Results::from_value(serde_json::to_value(results)?)?;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let json_path = dir.join("results.json");
-    std::fs::write(&json_path, serde_json::to_string_pretty(results)?)
-        .with_context(|| format!("cannot write {}", json_path.display()))?;
+    mts::output::write_file(
+        &json_path,
+        serde_json::to_string_pretty(results)?.as_bytes(),
+    )?;
     let charts = super::charts::write_all(dir, results)?;
     let mut text = report(results);
     if !charts.is_empty() {
@@ -1416,7 +1418,7 @@ pub fn write(dir: &Path, results: &Results) -> Result<()> {
         }
     }
     let md = dir.join("report.md");
-    std::fs::write(&md, text).with_context(|| format!("cannot write {}", md.display()))?;
+    mts::output::write_file(&md, text.as_bytes())?;
     Ok(())
 }
 

@@ -5,6 +5,7 @@
 use super::render::Size;
 use super::MeshSource;
 use crate::results::{ModelFit, Scene, VertexRow, VertexWork};
+use crate::stdout::outln;
 use anyhow::Result;
 use clap::Args;
 use mts::{peers, Extractor, StripifyOptions};
@@ -38,7 +39,7 @@ pub struct BenchRenderArgs {
     scene_with: Vec<std::path::PathBuf>,
     /// The scene's screen-space error allowed, in pixels.
     #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR,
-          value_parser = crate::pixel_error)]
+          allow_negative_numbers = true, value_parser = crate::pixel_error)]
     pixel_error: f32,
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -327,12 +328,12 @@ fn bytemuck_triangles(flat: &[u32]) -> &[[u32; 3]] {
 }
 
 /// The vertex-work rows as text.
-fn print_vertex_work(w: &VertexWork) {
-    println!("vertex work (adapter counts; modelled invocations per cache model):");
+fn print_vertex_work(w: &VertexWork) -> Result<()> {
+    outln!("vertex work (adapter counts; modelled invocations per cache model):")?;
     if let Some(note) = &w.note {
-        println!("  {note}");
+        outln!("  {note}")?;
     }
-    println!(
+    outln!(
         "{:>6} {:>14} {:>9} {:>9} {:>10} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
         "level",
         "method",
@@ -345,10 +346,10 @@ fn print_vertex_work(w: &VertexWork) {
         "batch96",
         "batch384",
         "lru32"
-    );
+    )?;
     let opt = |x: Option<u64>| x.map_or("—".into(), |x| x.to_string());
     for r in &w.rows {
-        println!(
+        outln!(
             "{:>5.0}% {:>14} {:>9} {:>9} {:>10} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8}",
             100.0 * r.ratio,
             r.method,
@@ -362,10 +363,10 @@ fn print_vertex_work(w: &VertexWork) {
             r.modelled["batch96"],
             r.modelled["batch384"],
             r.modelled["lru32"],
-        );
+        )?;
     }
     if let Some(best) = &w.best_model {
-        println!(
+        outln!(
             "best-fitting model: {best}; clipper count differs from triangles in {} rows \
              ({} from the primitives assembled, degenerate windows included)",
             w.clipper_mismatches,
@@ -375,8 +376,9 @@ fn print_vertex_work(w: &VertexWork) {
                     .clipper_invocations
                     .is_some_and(|c| c != r.primitives_assembled))
                 .count()
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// Median milliseconds of `frames` frames of `renderer` into `target`.
@@ -443,12 +445,19 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
     let mut ex = Extractor::new(&model);
     let mut rows = Vec::new();
     if !args.json {
-        println!("{name}: {} x {} pixels", args.size.0, args.size.1);
-        println!("adapter: {report}");
-        println!(
+        outln!("{name}: {} x {} pixels", args.size.0, args.size.1)?;
+        outln!("adapter: {report}")?;
+        outln!(
             "{:>6} {:>9} {:>7} {:>10} {:>9} {:>8} {:>10} {:>11}",
-            "level", "triangles", "method", "indices", "ms/frame", "fps", "Mtri/s", "LoD step us"
-        );
+            "level",
+            "triangles",
+            "method",
+            "indices",
+            "ms/frame",
+            "fps",
+            "Mtri/s",
+            "LoD step us"
+        )?;
     }
     for ratio in [1.0, 0.5, 0.1] {
         let lod = model.lod_for_ratio(ratio);
@@ -467,11 +476,11 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
             let fps = 1e3 / ms;
             let mtri = triangles as f64 * fps / 1e6;
             if !args.json {
-                println!(
+                outln!(
                     "{:>5.0}% {triangles:>9} {method:>7} {indices:>10} {ms:>9.2} {fps:>8.1} {mtri:>10.2} {:>11}",
                     100.0 * ratio,
                     step.map_or(String::new(), |s| format!("{s:.0}"))
-                );
+                )?;
             }
             rows.push(RenderRow {
                 ratio,
@@ -489,7 +498,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
     }
     let vertex = measure_vertex_work(&gpu, &target, &config, &name, &model, &camera)?;
     if !args.json {
-        print_vertex_work(&vertex);
+        print_vertex_work(&vertex)?;
     }
     let scene = if args.scene > 0 {
         let others = crate::demo_scene::load_models(&args.scene_with)?;
@@ -515,7 +524,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
         };
         // Through a `Value`, whose keys are sorted: the order this output
         // has always had.
-        println!("{}", serde_json::to_value(out)?);
+        outln!("{}", serde_json::to_value(out)?)?;
     }
     Ok(())
 }
@@ -537,14 +546,14 @@ fn bench_scene(
     };
     let row = scene_rows(gpu, target, config, models, &spec)?.remove(0);
     if !args.json {
-        print_scene(&row);
+        print_scene(&row)?;
     }
     Ok(row)
 }
 
 /// One scene row as text.
-pub fn print_scene(r: &Scene) {
-    println!(
+pub fn print_scene(r: &Scene) -> Result<()> {
+    outln!(
         "scene: {} instances of {} models ({}), {}×{} pixels, {} frames along the path:",
         r.instances,
         r.models,
@@ -552,9 +561,9 @@ pub fn print_scene(r: &Scene) {
         r.width,
         r.height,
         r.frames
-    );
-    println!("{}", super::bench::scene_table_head());
-    println!("{}", super::bench::scene_table_row(r));
+    )?;
+    outln!("{}", super::bench::scene_table_head())?;
+    outln!("{}", super::bench::scene_table_row(r))
 }
 
 /// Frames of the path compared with full detail by `mts bench render`.

@@ -30,19 +30,21 @@ pub fn write_all(dir: &Path, results: &Results) -> Result<Vec<PathBuf>> {
         .or_else(|| models.first())
     {
         let path = dir.join("indices.png");
-        indices_chart(&path, m)?;
+        mts::output::write_through(&path, |p| indices_chart(p, m))?;
         written.push(path);
         if let Some(figure6) = &m.figure6 {
             for mode in ["immediate", "per_second"] {
                 let path = dir.join(format!("figure6_{mode}.png"));
-                figure6_chart(&path, &m.name, &figure6.rows, mode)?;
+                mts::output::write_through(&path, |p| {
+                    figure6_chart(p, &m.name, &figure6.rows, mode)
+                })?;
                 written.push(path);
             }
         }
     }
     if let Some(scale) = &results.scale {
         let path = dir.join("scale.png");
-        scale_chart(&path, &scale.rows)?;
+        mts::output::write_through(&path, |p| scale_chart(p, &scale.rows))?;
         written.push(path);
     }
     Ok(written)

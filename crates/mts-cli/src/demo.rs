@@ -4,6 +4,7 @@
 //! (headless), and prints the side-by-side summary: indices sent by MTS
 //! strips, a triangle list and meshoptimizer's strips of each level.
 
+use crate::stdout::outln;
 use anyhow::Result;
 use mts::model::{build_from_mesh, sequence, PipelineOptions};
 use mts::Extractor;
@@ -17,14 +18,14 @@ const THUMBNAIL: u32 = 256;
 /// Runs the demo on `mesh` (named `name`), prints its summary and writes
 /// the thumbnails to `thumbnails` (when the renderer is built in).
 pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result<()> {
-    println!(
+    outln!(
         "{name}: {} triangles, {} vertices",
         mesh.triangle_count(),
         mesh.vertex_count()
-    );
+    )?;
     let (model, stop, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-    println!(
+    outln!(
         "built the MTS model in {:.0} ms (strips {:.0} ms beside the contraction sequence {:.0} ms, graphs {:.0} ms): {} LoDs down to {} triangles, {} bands, {} strips at LoD 0",
         ms(t.total),
         ms(t.stripify),
@@ -34,12 +35,12 @@ pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result
         stop.triangles,
         model.band_count(),
         model.base_strips().run_count(),
-    );
+    )?;
     let file_bytes = model.to_bytes().len();
-    println!(
+    outln!(
         ".mts file {file_bytes} bytes = {:.2} x the raw mesh (12 bytes per vertex + 12 per triangle)",
         file_bytes as f64 / model.raw_bytes() as f64
-    );
+    )?;
     // A sweep from the coarsest LoD to the full mesh, one LoD at a time
     // over a window, as a viewer zooming in would ask for them.
     let lods = sequence::linear(model.max_lod(), model.max_lod() + 1);
@@ -56,20 +57,26 @@ pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result
         ex.set_lod_from_scratch(l);
     }
     let scratch = t0.elapsed().as_secs_f64() * 1e6 / sample.len().max(1) as f64;
-    println!(
+    outln!(
         "swept all {} LoDs coarsest to finest: {coherent:.1} us per LoD with the coherence cache ({:.1} strips walked per step), {scratch:.1} us from scratch ({:.0}x)",
         lods.len(),
         walked as f64 / lods.len() as f64,
         scratch / coherent
-    );
+    )?;
     let levels = super::bench::measure_levels(&model);
-    println!();
-    println!(
+    outln!()?;
+    outln!(
         "{:>6} {:>9} {:>12} {:>12} {:>14} {:>10} {:>12}",
-        "share", "triangles", "MTS strips", "tri. list", "meshopt strips", "MTS/list", "extract us"
-    );
+        "share",
+        "triangles",
+        "MTS strips",
+        "tri. list",
+        "meshopt strips",
+        "MTS/list",
+        "extract us"
+    )?;
     for l in &levels {
-        println!(
+        outln!(
             "{:>5.0}% {:>9} {:>12} {:>12} {:>14} {:>10.3} {:>12.1}",
             l.share * 100.0,
             l.triangles,
@@ -78,13 +85,13 @@ pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result
             l.meshopt_strip_indices,
             l.mts_indices as f64 / l.list_indices as f64,
             l.extract_us,
-        );
+        )?;
     }
     match render_thumbnails(&model, thumbnails) {
-        Ok(line) => println!("\n{line}"),
-        Err(e) => println!("\nthumbnails skipped: {e:#}"),
+        Ok(line) => outln!("\n{line}")?,
+        Err(e) => outln!("\nthumbnails skipped: {e:#}")?,
     }
-    println!("\n(indices sent to the GPU per level: MTS strips with restart values, the triangle list, meshoptimizer's strips of that level's mesh; `mts bench` measures the full tables)");
+    outln!("\n(indices sent to the GPU per level: MTS strips with restart values, the triangle list, meshoptimizer's strips of that level's mesh; `mts bench` measures the full tables)")?;
     Ok(())
 }
 

@@ -5,6 +5,7 @@
 //! [`InstancedScene`] knows nothing of it: a host places its own
 //! instances.
 
+use crate::stdout::warnln;
 use glam::{Mat4, Vec3};
 use mts::{MtsModel, Result};
 use mts_render::{Camera, FrameStats, InstanceId, InstancedScene, RendererConfig, StripRenderer};
@@ -55,7 +56,7 @@ impl<'m> DemoScene<'m> {
         for model in models {
             let id = scene.add_model_with(device, queue, model, appearance)?;
             for w in scene.warnings(id) {
-                eprintln!("{w}");
+                warnln!("{w}");
             }
             let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
             let radius = ((mts::mesh::diagonal_of(min, max) * 0.5) as f32).max(f32::MIN_POSITIVE);

@@ -1,5 +1,6 @@
 //! The `mts` command: multiresolution triangle strips from the command line.
 
+use crate::stdout::{out, outln, warnln};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use mts::mesh::generate::Generated;
@@ -10,7 +11,7 @@ use mts::{peers, stripify, StripifyOptions};
 use results::MethodRow;
 use serde_json::json;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 mod bench;
@@ -22,6 +23,7 @@ mod demo_scene;
 mod figure6;
 mod render;
 mod results;
+mod stdout;
 mod summary;
 mod viewer;
 
@@ -125,19 +127,18 @@ fn bench_check(args: &CheckArgs) -> Result<()> {
         );
     }
     match &r.machine.adapter {
-        Some(a) => println!(
+        Some(a) => outln!(
             "{}: complete ({} models; Figure 6 and the scene on {a})",
             args.results.display(),
             r.models.len()
         ),
-        None => println!(
+        None => outln!(
             "{}: complete ({} models; no adapter: {})",
             args.results.display(),
             r.models.len(),
             r.machine.adapter_note.as_deref().unwrap_or("?")
         ),
     }
-    Ok(())
 }
 
 #[derive(Args)]
@@ -160,7 +161,7 @@ fn bench_summary(args: &SummaryArgs) -> Result<()> {
         let dir = path
             .parent()
             .map_or_else(String::new, |p| p.display().to_string());
-        print!("{}", summary::summary(&results, &dir));
+        out!("{}", summary::summary(&results, &dir))?;
         return Ok(());
     };
     // Links are relative to the README.
@@ -190,11 +191,11 @@ fn bench_summary(args: &SummaryArgs) -> Result<()> {
                 readme.display()
             );
         }
-        println!("{} matches {}", readme.display(), path.display());
+        outln!("{} matches {}", readme.display(), path.display())?;
         return Ok(());
     }
-    std::fs::write(readme, new).with_context(|| format!("cannot write {}", readme.display()))?;
-    println!("rewrote the bench section of {}", readme.display());
+    mts::output::write_file(readme, new.as_bytes())?;
+    outln!("rewrote the bench section of {}", readme.display())?;
     Ok(())
 }
 
@@ -262,12 +263,12 @@ fn bench_cmd(args: &BenchArgs) -> Result<()> {
     })?;
     bar.finish_and_clear();
     bench::write(&args.out, &results)?;
-    println!(
+    outln!(
         "wrote {} and {} in {:.0} s",
         args.out.join("report.md").display(),
         args.out.join("results.json").display(),
         t.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }
 
@@ -352,7 +353,7 @@ struct MeshSource {
     /// OBJ or PLY file (or an .mts model, for the commands that read a
     /// model).
     #[arg(conflicts_with = "generated")]
-    mesh: Option<PathBuf>,
+    pub(crate) mesh: Option<PathBuf>,
     /// Built-in mesh NAME:SIZE, SIZE in triangles (k/M suffixes):
     /// icosphere:100k, torus:1M, grid:20k. The default when no file is given.
     #[arg(long, value_name = "NAME:SIZE")]
@@ -367,6 +368,13 @@ struct MeshSource {
     /// them (its scenes do not carry them yet).
     #[arg(long)]
     properties: bool,
+    /// The most triangles the input file may ask for (polygons
+    /// triangulated, strips decoded, glTF instances counted each time;
+    /// three times as many vertices): a bound on the work and memory a
+    /// small file can ask for. About 650 bytes a triangle to build.
+    #[arg(long, value_name = "N", default_value_t = mts::mesh::io::DEFAULT_MAX_TRIANGLES as usize,
+          value_parser = count_in::<1, { 1 << 32 }>, allow_negative_numbers = true)]
+    max_triangles: usize,
 }
 
 impl MeshSource {
@@ -374,21 +382,22 @@ impl MeshSource {
     /// or the model of the mesh, built first with the default options (a
     /// progress bar on large inputs).
     fn model(&self) -> Result<(String, mts::MtsModel)> {
-        if let Some(path) = &self.mesh {
-            let is_mts = std::fs::File::open(path)
-                .and_then(|mut f| {
-                    use std::io::Read;
-                    let mut magic = [0u8; 8];
-                    f.read_exact(&mut magic)
-                        .map(|()| &magic == mts::model::format::MAGIC)
-                })
-                .unwrap_or(false);
-            if is_mts {
-                let model = mts::MtsModel::load(path)?;
-                return Ok((path.display().to_string(), model));
+        let (name, mesh) = match &self.mesh {
+            Some(path) => {
+                let bytes = mts::mesh::io::read_file(path)?;
+                if bytes.starts_with(mts::model::format::MAGIC) {
+                    let model = mts::MtsModel::from_bytes(&bytes, path)?;
+                    return Ok((path.display().to_string(), model));
+                }
+                let (mesh, _) = mts::mesh::io::load_bytes(&bytes, path, self.load_options())
+                    .context("cannot load the mesh")?;
+                (path.display().to_string(), mesh)
             }
-        }
-        let (name, mesh, _) = self.load()?;
+            None => {
+                let (name, mesh, _) = self.load()?;
+                (name, mesh)
+            }
+        };
         let (model, _, _) = build_with_bar(&mesh, &Default::default());
         Ok((name, model))
     }
@@ -402,14 +411,27 @@ impl MeshSource {
         self.load()
     }
 
+    /// Refuses `output` when it names the input file (or one of `more`):
+    /// the input would be replaced by what was made from it.
+    fn check_output(&self, output: &Path) -> Result<()> {
+        check_output(
+            output,
+            &self.mesh.iter().map(PathBuf::as_path).collect::<Vec<_>>(),
+        )
+    }
+
+    fn load_options(&self) -> LoadOptions {
+        LoadOptions {
+            clean: CleanOptions { weld: self.weld },
+            properties: self.properties,
+            max_triangles: self.max_triangles as u64,
+        }
+    }
+
     fn load(&self) -> Result<(String, Mesh, CleanReport)> {
         let clean = CleanOptions { weld: self.weld };
         if let Some(path) = &self.mesh {
-            let options = LoadOptions {
-                clean,
-                properties: self.properties,
-            };
-            let (mesh, report) = load(path, options).context("cannot load the mesh")?;
+            let (mesh, report) = load(path, self.load_options()).context("cannot load the mesh")?;
             Ok((path.display().to_string(), mesh, report))
         } else {
             let g = self.generated.unwrap_or(Generated::DEFAULT);
@@ -487,13 +509,13 @@ struct SimplifyArgs {
     boundary_weight: Option<f64>,
     /// Weight of texture-coordinate distortion in the cost, with
     /// --properties (an error of 1/weight costs one bounding-box diagonal).
-    #[arg(long, value_name = "WEIGHT")]
+    #[arg(long, value_name = "WEIGHT", allow_negative_numbers = true, value_parser = non_negative::<f32>)]
     uv_weight: Option<f32>,
     /// Weight of normal distortion in the cost, with --properties.
-    #[arg(long, value_name = "WEIGHT")]
+    #[arg(long, value_name = "WEIGHT", allow_negative_numbers = true, value_parser = non_negative::<f32>)]
     normal_weight: Option<f32>,
     /// Weight of colour distortion in the cost, with --properties.
-    #[arg(long, value_name = "WEIGHT")]
+    #[arg(long, value_name = "WEIGHT", allow_negative_numbers = true, value_parser = non_negative::<f32>)]
     color_weight: Option<f32>,
     /// Surface samples per side for the error measurement.
     #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES, value_parser = count_in::<1, MAX_SAMPLES>, allow_negative_numbers = true)]
@@ -524,6 +546,19 @@ struct ConvertArgs {
     /// The OBJ file to write.
     #[arg(short, long)]
     output: PathBuf,
+}
+
+/// Refuses `output` when it is one of `inputs` (the same file, whatever
+/// the path): writing it would replace what the command reads.
+pub(crate) fn check_output(output: &Path, inputs: &[&Path]) -> Result<()> {
+    if let Some(input) = inputs.iter().find(|i| mts::output::is_same_file(output, i)) {
+        bail!(
+            "{}: the output is the input file {}: write to another file",
+            output.display(),
+            input.display()
+        );
+    }
+    Ok(())
 }
 
 /// A count argument in `MIN..=MAX`: what clap calls for `--repeat`,
@@ -671,21 +706,21 @@ fn strips(args: &StripsArgs) -> Result<()> {
         v["list_acmr_batch96"] = list_batch96;
         v["mesh"] = json!(name);
         v["vertices"] = json!(mesh.vertex_count());
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?)?;
         return Ok(());
     }
-    println!(
+    outln!(
         "{name}: {} vertices, {} triangles ({} degenerate and {} unreferenced dropped, {} welded)",
         mesh.vertex_count(),
         mesh.triangle_count(),
         report.degenerate_dropped,
         report.unreferenced_dropped,
         report.welded
-    );
+    )?;
     if let Some(why) = &skipped {
-        println!("{why}");
+        outln!("{why}")?;
     }
-    println!("{:<22}{:>14}{:>14}", "", "mts", "meshopt");
+    outln!("{:<22}{:>14}{:>14}", "", "mts", "meshopt")?;
     let peer = peer.unwrap_or_default();
     // Each row: its label and the figure of a side.
     type Figure = fn(&StripStats) -> String;
@@ -707,22 +742,25 @@ fn strips(args: &StripsArgs) -> Result<()> {
         ("ms (median)", |s| format!("{:.2}", s.ms)),
     ];
     for (label, figure) in rows {
-        println!("{label:<22}{:>14}{:>14}", figure(&mine), figure(&peer));
+        outln!("{label:<22}{:>14}{:>14}", figure(&mine), figure(&peer))?;
     }
     if skipped.is_none() {
         // The list the strips are weighed against: meshoptimizer's
         // cache-ordered triangles.
         let (fifo, batch) = list_acmr_json(&mesh);
-        println!(
+        outln!(
             "meshoptimizer-ordered list: ACMR {:.3} (FIFO 16), {:.3} (batch 96)",
             fifo.as_f64().unwrap_or(f64::NAN),
             batch.as_f64().unwrap_or(f64::NAN)
-        );
+        )?;
     }
     Ok(())
 }
 
 fn simplify(args: &SimplifyArgs) -> Result<()> {
+    if let Some(out) = &args.output {
+        args.source.check_output(out)?;
+    }
     use mts::distance::surface_distance;
     use mts::peers::quality::{self, Measurement};
     use mts::simplify::{Placement, SimplifyOptions};
@@ -769,7 +807,7 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
     }
     let skipped = peers::meshopt::refusal(&mesh);
     if let Some(why) = &skipped {
-        eprintln!("{name}: {why}");
+        warnln!("{name}: {why}");
     }
     // Our LoD over every input and appended position, referenced or not:
     // the surface `mts simplify` has always measured (the bench drops the
@@ -822,15 +860,15 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
         "meshopt": peer,
     });
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?)?;
         return Ok(());
     }
-    println!(
+    outln!(
         "{name}: {input} triangles -> target {target}; sequence of {} contractions, {}",
         collapses.max_lod(),
         whole.stop
-    );
-    println!("{:<26}{:>14}{:>14}", "", "mts", "meshopt");
+    )?;
+    outln!("{:<26}{:>14}{:>14}", "", "mts", "meshopt")?;
     let peer = &v["meshopt"];
     let show = |x: &serde_json::Value, digits: usize| {
         x.as_f64()
@@ -855,9 +893,9 @@ fn simplify(args: &SimplifyArgs) -> Result<()> {
         ("RMS / diagonal", show(&v["rms"], 6), show(&peer["rms"], 6)),
     ];
     for (label, mine, theirs) in rows {
-        println!("{label:<26}{mine:>14}{theirs:>14}");
+        outln!("{label:<26}{mine:>14}{theirs:>14}")?;
     }
-    println!("{:<26}{:>14.1}", "ms (whole sequence)", ms);
+    outln!("{:<26}{:>14.1}", "ms (whole sequence)", ms)?;
     Ok(())
 }
 
@@ -875,18 +913,22 @@ fn distance(args: &DistanceArgs) -> Result<()> {
             "forward": d.forward,
             "backward": d.backward,
         });
-        println!("{v}");
+        outln!("{v}")?;
     } else {
-        println!(
+        outln!(
             "Hausdorff {:.6}  RMS {:.6}  (relative to the reference's diagonal; \
              reference -> other {:.6}, other -> reference {:.6})",
-            d.hausdorff, d.rms, d.forward, d.backward
-        );
+            d.hausdorff,
+            d.rms,
+            d.forward,
+            d.backward
+        )?;
     }
     Ok(())
 }
 
 fn convert(args: &ConvertArgs) -> Result<()> {
+    args.source.check_output(&args.output)?;
     let (_, mesh, _) = args.source.load()?;
     mts::mesh::io::save_mesh(&mesh, &args.output)?;
     Ok(())
@@ -919,6 +961,7 @@ fn run(cli: &Cli) -> Result<()> {
 const PROGRESS_MIN_TRIANGLES: usize = 200_000;
 
 fn build(args: &BuildArgs) -> Result<()> {
+    args.source.check_output(&args.output)?;
     let started = std::time::Instant::now();
     let (name, mesh, _) = args.source.load()?;
     let load = started.elapsed();
@@ -937,12 +980,11 @@ fn build(args: &BuildArgs) -> Result<()> {
     } else {
         model.to_bytes()
     };
-    std::fs::write(&args.output, &bytes)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    mts::output::write_file(&args.output, &bytes)?;
     let st = model.stats();
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     if args.json {
-        println!(
+        outln!(
             "{}",
             json!({
                 "input": name,
@@ -963,43 +1005,43 @@ fn build(args: &BuildArgs) -> Result<()> {
                 "ms_model": ms(t.model),
                 "ms": ms(t.total),
             })
-        );
+        )?;
     } else {
-        println!(
+        outln!(
             "{name}: {} triangles, {} vertices, {} LoDs",
             mesh.triangle_count(),
             mesh.vertex_count(),
             model.max_lod() + 1
-        );
-        println!(
+        )?;
+        outln!(
             "  time      load {:.1} ms; stripify {:.1} ms beside simplify {:.1} ms, model {:.1} ms, total {:.1} ms",
             ms(load),
             ms(t.stripify),
             ms(t.simplify),
             ms(t.model),
             ms(t.total)
-        );
-        println!(
+        )?;
+        outln!(
             "  model     {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
             model.band_count(),
             st.strips,
             st.nodes,
             st.arcs,
             st.memory_bytes as f64 / 1e6
-        );
-        println!(
+        )?;
+        outln!(
             "  file      {} bytes = {:.2} x raw ({} bytes: 12 per vertex and its properties, 12 per triangle) -> {}",
             bytes.len(),
             bytes.len() as f64 / model.raw_bytes() as f64,
             model.raw_bytes(),
             args.output.display()
-        );
+        )?;
         if !args.recipe_only {
-            println!(
+            outln!(
                 "            of which the recipe {} bytes = {:.2} x raw (what --recipe-only writes)",
                 recipe.len(),
                 recipe.len() as f64 / model.raw_bytes() as f64
-            );
+            )?;
         }
     }
     Ok(())
@@ -1163,6 +1205,9 @@ fn make_source<'m>(
 
 fn extract(args: &ExtractArgs) -> Result<()> {
     use mts::Extractor;
+    if let Some(out) = &args.output {
+        args.source.check_output(out)?;
+    }
     if args.method != Method::Mts {
         return extract_baseline(args);
     }
@@ -1195,39 +1240,39 @@ fn extract(args: &ExtractArgs) -> Result<()> {
         .filter(|r| !r.is_empty())
         .count();
     let triangles = model.triangle_count(lod);
+    let mut vertices_written = None;
     if let Some(out) = &args.output {
-        let mesh = Mesh {
-            positions: model.positions().to_vec(),
-            triangles: ex.triangles(),
-            // The input vertices' (a model with properties has no created
-            // vertices: endpoint placement).
-            properties: model.properties().clone(),
-        };
+        // The level's own vertices only, renumbered; their properties are
+        // the input vertices' (a model with properties has no created
+        // vertices: endpoint placement).
+        let mesh = Mesh::level(model.positions(), &ex.triangles(), model.properties());
         mts::mesh::io::save_mesh(&mesh, out)?;
+        vertices_written = Some(mesh.vertex_count());
     }
     if args.json {
-        println!(
-            "{}",
-            json!({
-                "input": name,
-                "lod": lod,
-                "max_lod": model.max_lod(),
-                "triangles": triangles,
-                "strips": runs,
-                "indices": ex.indices_sent(),
-                "indices_per_triangle": ex.indices_sent() as f64 / triangles.max(1) as f64,
-                "us": us,
-                "load_ms": load_ms,
-            })
-        );
+        let mut v = json!({
+            "input": name,
+            "lod": lod,
+            "max_lod": model.max_lod(),
+            "triangles": triangles,
+            "strips": runs,
+            "indices": ex.indices_sent(),
+            "indices_per_triangle": ex.indices_sent() as f64 / triangles.max(1) as f64,
+            "us": us,
+            "load_ms": load_ms,
+        });
+        if let Some(n) = vertices_written {
+            v["vertices_written"] = json!(n);
+        }
+        outln!("{v}")?;
     } else {
-        println!(
+        outln!(
             "{name}: LoD {lod} of {}: {triangles} triangles in {runs} strips, {} indices sent ({:.3} per triangle), extracted in {us:.1} us (median of {} from scratch)",
             model.max_lod(),
             ex.indices_sent(),
             ex.indices_sent() as f64 / triangles.max(1) as f64,
             times.len()
-        );
+        )?;
     }
     Ok(())
 }
@@ -1266,7 +1311,7 @@ fn verify(args: &VerifyArgs) -> Result<()> {
     let report = mts::model::verify(&model, &model.mesh(), &lods);
     let secs = t.elapsed().as_secs_f64();
     if args.json {
-        println!(
+        outln!(
             "{}",
             json!({
                 "input": name,
@@ -1275,14 +1320,14 @@ fn verify(args: &VerifyArgs) -> Result<()> {
                 "first_mismatch": report.first_mismatch.as_ref().map(|(l, what)| json!({"lod": l, "what": what})),
                 "seconds": secs,
             })
-        );
+        )?;
     } else {
-        println!(
+        outln!(
             "{name}: {} LoDs checked against the replay oracle and from-scratch extraction in {secs:.2} s, {} mismatches",
             report.lods_checked, report.mismatches
-        );
+        )?;
         if let Some((lod, what)) = &report.first_mismatch {
-            println!("  first at LoD {lod}: {what}");
+            outln!("  first at LoD {lod}: {what}")?;
         }
     }
     if let Some((lod, what)) = &report.first_mismatch {
@@ -1374,18 +1419,18 @@ fn info(args: &InfoArgs) -> Result<()> {
                 "texture": texture,
             });
         }
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?)?;
     } else {
-        println!(
+        outln!(
             "{}: {} bytes ({:.2} x raw), loaded and built in {load_ms:.1} ms",
             args.model.display(),
             file_bytes,
             file_bytes as f64 / model.raw_bytes() as f64
-        );
-        println!("  {} vertices, {} triangles, {} LoDs, {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
-            model.positions().len(), model.triangle_count(0), model.max_lod() + 1, model.band_count(), st.strips, st.nodes, st.arcs, st.memory_bytes as f64 / 1e6);
+        )?;
+        outln!("  {} vertices, {} triangles, {} LoDs, {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
+            model.positions().len(), model.triangle_count(0), model.max_lod() + 1, model.band_count(), st.strips, st.nodes, st.arcs, st.memory_bytes as f64 / 1e6)?;
         if !props.is_empty() {
-            println!(
+            outln!(
                 "  properties: {} on {points} points; texture: {}",
                 if streams.is_empty() {
                     "none".to_string()
@@ -1393,14 +1438,19 @@ fn info(args: &InfoArgs) -> Result<()> {
                     streams.join(", ")
                 },
                 texture.as_deref().unwrap_or("none")
-            );
+            )?;
         }
-        println!(
+        outln!(
             "  {:>6} {:>7} {:>9} {:>9} {:>11} {:>7}",
-            "share", "LoD", "triangles", "idx/tri", "restripify", "ratio"
-        );
+            "share",
+            "LoD",
+            "triangles",
+            "idx/tri",
+            "restripify",
+            "ratio"
+        )?;
         for l in &levels {
-            println!(
+            outln!(
                 "  {:>5.0}% {:>7} {:>9} {:>9.3} {:>11.3} {:>7.3}",
                 l["ratio"].as_f64().unwrap_or(0.0) * 100.0,
                 l["lod"].as_u64().unwrap_or(0),
@@ -1410,7 +1460,7 @@ fn info(args: &InfoArgs) -> Result<()> {
                     .as_f64()
                     .unwrap_or(0.0),
                 l["quality_ratio"].as_f64().unwrap_or(0.0),
-            );
+            )?;
         }
     }
     Ok(())
@@ -1432,6 +1482,9 @@ fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     match run(&cli) {
         Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<stdout::ClosedPipe>().is_some() => {
+            std::process::ExitCode::from(141)
+        }
         Err(e) => {
             // One line: the context, then each cause not already said.
             let mut line = e.to_string();
@@ -1441,7 +1494,9 @@ fn main() -> std::process::ExitCode {
                     line = format!("{line}: {text}");
                 }
             }
-            eprintln!("error: {line}");
+            // Standard error may be closed or full too: then the status
+            // alone tells.
+            warnln!("error: {line}");
             std::process::ExitCode::FAILURE
         }
     }
@@ -1467,16 +1522,12 @@ fn extract_baseline(args: &ExtractArgs) -> Result<()> {
     let us = times[times.len() / 2];
     let triangles = source.triangles();
     if let Some(out) = &args.output {
-        let m = Mesh {
-            positions: mesh.positions.clone(),
-            triangles: triangles.clone(),
-            properties: Default::default(),
-        };
+        let m = Mesh::level(&mesh.positions, &triangles, &Default::default());
         mts::mesh::io::save_mesh(&m, out)?;
     }
     let method = source.name();
     if args.json {
-        println!(
+        outln!(
             "{}",
             json!({
                 "input": name,
@@ -1488,15 +1539,15 @@ fn extract_baseline(args: &ExtractArgs) -> Result<()> {
                 "indices_per_triangle": source.indices().len() as f64 / triangles.len().max(1) as f64,
                 "us": us,
             })
-        );
+        )?;
     } else {
-        println!(
+        outln!(
             "{name}: {method} LoD {lod} of {}: {} triangles, {} indices sent, set in {us:.1} us (median of {} from a fresh source)",
             source.max_lod(),
             triangles.len(),
             source.indices().len(),
             times.len()
-        );
+        )?;
     }
     Ok(())
 }
@@ -1530,16 +1581,16 @@ fn with_properties(mesh: &Mesh) -> String {
 }
 
 fn encode(args: &EncodeArgs) -> Result<()> {
+    args.source.check_output(&args.output)?;
     let (name, mesh, _) = args.source.load()?;
     let t = Instant::now();
     let tree = mts::baselines::ClusterTree::new(&mesh)?;
     let bytes = tree.to_stream();
     let ms = t.elapsed().as_secs_f64() * 1e3;
-    std::fs::write(&args.output, &bytes)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    mts::output::write_file(&args.output, &bytes)?;
     let raw = raw_bytes_u16(&mesh);
     if args.json {
-        println!(
+        outln!(
             "{}",
             json!({
                 "input": name,
@@ -1550,9 +1601,9 @@ fn encode(args: &EncodeArgs) -> Result<()> {
                 "ratio": bytes.len() as f64 / raw as f64,
                 "ms": ms,
             })
-        );
+        )?;
     } else {
-        println!(
+        outln!(
             "{name}: {} vertices, {} triangles -> {} bytes = {:.1}% of raw ({raw} bytes: 12 per vertex{} + 6 per triangle), {ms:.0} ms -> {}",
             mesh.vertex_count(),
             mesh.triangle_count(),
@@ -1560,7 +1611,7 @@ fn encode(args: &EncodeArgs) -> Result<()> {
             100.0 * bytes.len() as f64 / raw as f64,
             with_properties(&mesh),
             args.output.display()
-        );
+        )?;
     }
     Ok(())
 }
@@ -1582,6 +1633,9 @@ struct DecodeArgs {
 
 fn decode(args: &DecodeArgs) -> Result<()> {
     use mts::baselines::cluster::stream;
+    if let Some(out) = &args.output {
+        check_output(out, &[&args.stream])?;
+    }
     let all = mts::mesh::io::read_file(&args.stream)?;
     let file = args.stream.display().to_string();
     let t = Instant::now();
@@ -1598,7 +1652,7 @@ fn decode(args: &DecodeArgs) -> Result<()> {
         mts::mesh::io::save_mesh(&mesh, out)?;
     }
     if args.json {
-        println!(
+        outln!(
             "{}",
             json!({
                 "input": file,
@@ -1611,9 +1665,9 @@ fn decode(args: &DecodeArgs) -> Result<()> {
                 "complete": d.is_complete(),
                 "ms": ms,
             })
-        );
+        )?;
     } else {
-        println!(
+        outln!(
             "{file}: {} of {} vertices and {} of {} triangles from {} bytes ({}), {ms:.1} ms",
             d.positions.len(),
             d.total_vertices,
@@ -1625,7 +1679,7 @@ fn decode(args: &DecodeArgs) -> Result<()> {
             } else {
                 "partial"
             }
-        );
+        )?;
     }
     Ok(())
 }
@@ -1773,17 +1827,17 @@ fn compare(args: &CompareArgs) -> Result<()> {
         "requests": args.requests,
     });
     if args.json {
-        println!("{}", json!({"mesh": mesh_info, "methods": rows}));
+        outln!("{}", json!({"mesh": mesh_info, "methods": rows}))?;
         return Ok(());
     }
-    println!(
+    outln!(
         "{name}: {} vertices, {} triangles, raw {raw} bytes (12 per vertex{} + 6 per triangle); {} requests per sequence",
         mesh.vertex_count(),
         mesh.triangle_count(),
         with_properties(&mesh),
         args.requests
-    );
-    println!(
+    )?;
+    outln!(
         "{:<12}{:>10}{:>12}{:>12}{:>8}{:>10}{:>10}{:>10}{:>10}",
         "method",
         "build ms",
@@ -1794,17 +1848,17 @@ fn compare(args: &CompareArgs) -> Result<()> {
         "us lin",
         "us exp",
         "us rand"
-    );
+    )?;
     for r in &rows {
         let r = match r {
             MethodRow::Measured(r) => r,
             MethodRow::Skipped { method, skipped } => {
-                println!("{method:<12}{skipped}");
+                outln!("{method:<12}{skipped}")?;
                 continue;
             }
         };
         let us = |seq: &str| r.us_per_change.get(seq).copied().unwrap_or(0.0);
-        println!(
+        outln!(
             "{:<12}{:>10.1}{:>12}{:>12}{:>8.3}{:>10}{:>10.1}{:>10.1}{:>10.1}",
             r.method,
             r.build_ms,
@@ -1815,10 +1869,10 @@ fn compare(args: &CompareArgs) -> Result<()> {
             us("linear"),
             us("exponential"),
             us("random"),
-        );
+        )?;
         if let Some(scratch) = &r.us_per_change_scratch {
             let s = |seq: &str| scratch.get(seq).copied().unwrap_or(0.0);
-            println!(
+            outln!(
                 "{:<12}{:>62}{:>10.1}{:>10.1}{:>10.1}  (coherent {:.2}x / {:.2}x / {:.2}x faster)",
                 "  scratch",
                 "",
@@ -1828,7 +1882,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
                 s("linear") / us("linear"),
                 s("exponential") / us("exponential"),
                 s("random") / us("random"),
-            );
+            )?;
         }
     }
     Ok(())

@@ -2,6 +2,7 @@
 //! strips or by the oracle triangle list, through `mts_render`.
 
 use super::{LevelArgs, MeshSource};
+use crate::stdout::{outln, warnln};
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use mts::{Extractor, MtsModel};
@@ -105,7 +106,7 @@ pub struct RenderArgs {
     /// by LoD bucket; 1000 when N is left out).
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
           conflicts_with_all = ["lod", "triangles", "ratio", "method"],
-          allow_negative_numbers = true, value_parser = crate::count_in::<1, { 1 << 20 }>)]
+          allow_negative_numbers = true, value_parser = crate::count_in::<1, { MAX_SCENE }>)]
     scene: Option<usize>,
     /// With --scene: more models (OBJ/PLY meshes), their instances taken
     /// in turn with the command's model.
@@ -114,11 +115,14 @@ pub struct RenderArgs {
     /// With --scene: the screen-space error allowed, in pixels (0 draws
     /// every instance at full detail).
     #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR, requires = "scene",
-          value_parser = crate::pixel_error)]
+          allow_negative_numbers = true, value_parser = crate::pixel_error)]
     pixel_error: f32,
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
+    let mut inputs: Vec<&Path> = args.scene_with.iter().map(PathBuf::as_path).collect();
+    inputs.extend(args.source.mesh.as_deref());
+    crate::check_output(&args.output, &inputs)?;
     let Size(width, height) = args.size;
     let t0 = Instant::now();
     let (name, model) = args.source.model()?;
@@ -155,7 +159,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             };
             let mut r = StripRenderer::for_model_with(device, queue, &config, &model, &appearance)?;
             for w in r.warnings() {
-                eprintln!("{w}");
+                warnln!("{w}");
             }
             if args.method == Method::Mts {
                 let mut ex = Extractor::new(&model);
@@ -185,7 +189,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         .to_possible_value()
         .map_or_else(String::new, |v| v.get_name().to_string());
     if args.json {
-        println!(
+        outln!(
             "{}",
             json!({
                 "input": name,
@@ -207,35 +211,30 @@ pub fn render(args: &RenderArgs) -> Result<()> {
                 "ms_render_readback": ms_render,
                 "output": args.output.display().to_string(),
             })
-        );
+        )?;
     } else {
-        print_text(&name, &report, &args.output, |line| println!("{line}"));
-        println!(
+        print_text(&name, &report, &args.output)?;
+        outln!(
             "  LoD {lod} of {}: {triangles} triangles by {method}, {indices_sent} indices sent \
              ({:.2} per triangle), {} drawn as {:?}",
             model.max_lod(),
             indices_sent as f64 / triangles.max(1) as f64,
             renderer.indices_drawn(),
             renderer.index_format()
-        );
-        println!(
+        )?;
+        outln!(
             "  time      model {ms_model:.1} ms, extract+upload {ms_extract:.2} ms, \
              render+readback {ms_render:.1} ms; {} foreground pixels of {}",
             image.foreground_pixels(),
             width as usize * height as usize
-        );
+        )?;
     }
     Ok(())
 }
 
-fn print_text(
-    name: &str,
-    report: &mts_render::AdapterReport,
-    output: &Path,
-    mut line: impl FnMut(String),
-) {
-    line(format!("{name} -> {}", output.display()));
-    line(format!("  adapter   {report}"));
+fn print_text(name: &str, report: &mts_render::AdapterReport, output: &Path) -> Result<()> {
+    outln!("{name} -> {}", output.display())?;
+    outln!("  adapter   {report}")
 }
 
 /// Frames timed after the first (which extracts every visible instance).
@@ -275,7 +274,7 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     image.save_png(&args.output)?;
     let memory = scene.scene.memory();
     if args.json {
-        println!(
+        outln!(
             "{}",
             json!({
                 "input": name,
@@ -302,10 +301,10 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
                 "gpu_vertex_bytes": memory.gpu_vertex_bytes,
                 "output": args.output.display().to_string(),
             })
-        );
+        )?;
     } else {
-        print_text(name, &report, &args.output, |line| println!("{line}"));
-        println!(
+        print_text(name, &report, &args.output)?;
+        outln!(
             "  scene     {count} instances, {} visible after culling: {} triangles ({:.1}% of full \
              detail) at {pixel_error} px, {} indices drawn in {} instanced draws",
             stats.visible,
@@ -313,15 +312,15 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
             100.0 * stats.triangles as f64 / stats.triangles_full_detail.max(1) as f64,
             stats.indices_drawn,
             stats.draws
-        );
-        println!(
+        )?;
+        outln!(
             "  time      first update {ms_first_update:.1} ms ({} buckets extracted, {} bytes \
              uploaded); frame {ms_frame:.1} ms ({:.1} fps, median of {SCENE_FRAMES})",
             first.extractions,
             first.upload_bytes,
             1e3 / ms_frame
-        );
-        println!(
+        )?;
+        outln!(
             "  memory    {} B CPU per instance, {:.1} KB CPU shared; GPU {:.1} KB in {} bucket \
              buffers and transforms, {:.1} KB vertices",
             memory.cpu_bytes_per_instance(),
@@ -329,10 +328,14 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
             memory.gpu_bytes() as f64 / 1e3,
             memory.buffers,
             memory.gpu_vertex_bytes as f64 / 1e3
-        );
+        )?;
     }
     Ok(())
 }
+
+/// Most instances `--scene` lays out (`render`, `view`): about 220 bytes of
+/// CPU and GPU memory each, so at most a few hundred MB.
+const MAX_SCENE: u64 = 1 << 20;
 
 /// Arguments of `mts view`.
 #[derive(Args)]
@@ -342,7 +345,8 @@ pub struct ViewArgs {
     source: MeshSource,
     /// Show N instances on a ground plane instead (1000 when N is left
     /// out); `F` flies through them.
-    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000")]
+    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
+          allow_negative_numbers = true, value_parser = crate::count_in::<1, { MAX_SCENE }>)]
     scene: Option<usize>,
     /// With --scene: more models (OBJ/PLY meshes), their instances taken
     /// in turn with the command's model.
@@ -380,9 +384,12 @@ pub fn view(args: &ViewArgs) -> Result<()> {
         &format!("mts view: {name}"),
         args.frames,
     )?;
-    println!(
+    outln!(
         "{name}: {} frames in {:.1} s on {}; last: {}",
-        report.frames, report.seconds, report.adapter, report.last_status
-    );
+        report.frames,
+        report.seconds,
+        report.adapter,
+        report.last_status
+    )?;
     Ok(())
 }

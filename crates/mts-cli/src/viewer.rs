@@ -11,6 +11,7 @@
 //! and frames per second.
 
 use crate::demo_scene::DemoScene;
+use crate::stdout::warnln;
 use glam::Vec3;
 use mts::model::Extractor;
 use mts::{Error, MtsModel, Result};
@@ -348,7 +349,7 @@ impl<'m> State<'m> {
                     &appearance,
                 )?;
                 for w in renderer.warnings() {
-                    eprintln!("{w}");
+                    warnln!("{w}");
                 }
                 let (lo, hi) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
                 let drawn = Drawn::Model {
@@ -478,7 +479,7 @@ impl<'m> State<'m> {
                         mts_render::scene::DEFAULT_PIXEL_ERROR,
                     )
                     .unwrap_or_else(|e| {
-                        eprintln!("scene update: {e}");
+                        warnln!("scene update: {e}");
                         mts_render::FrameStats::default()
                     });
                 if stats.lod_changes > 0 {

@@ -113,19 +113,16 @@ impl Image {
     /// # Errors
     /// [`Error::Io`] when the file cannot be created or written.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        let io = |source: std::io::Error| Error::Io {
-            file: path.to_owned(),
-            source,
-        };
-        let file = std::fs::File::create(path).map_err(io)?;
-        let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
-        encoder.set_color(png::ColorType::Rgba);
-        encoder.set_depth(png::BitDepth::Eight);
-        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        let png_error = |e: png::EncodingError| io(std::io::Error::other(e));
-        let mut writer = encoder.write_header().map_err(png_error)?;
-        writer.write_image_data(&self.rgba).map_err(png_error)?;
-        writer.finish().map_err(png_error)
+        mts::output::write_with(path, |file| {
+            let mut encoder = png::Encoder::new(file, self.width, self.height);
+            encoder.set_color(png::ColorType::Rgba);
+            encoder.set_depth(png::BitDepth::Eight);
+            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+            let png_error = std::io::Error::other;
+            let mut writer = encoder.write_header().map_err(png_error)?;
+            writer.write_image_data(&self.rgba).map_err(png_error)?;
+            writer.finish().map_err(png_error)
+        })
     }
 }
 

@@ -39,6 +39,7 @@ pub mod lod;
 pub mod mesh;
 pub mod methods;
 pub mod model;
+pub mod output;
 #[cfg(feature = "peers")]
 pub mod peers;
 pub mod screen_error;

@@ -6,7 +6,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 use mts::mesh::generate::torus;
-use mts::mesh::io::{load, parse_gltf, save_gltf, Format, LoadOptions};
+use mts::mesh::io::{load, parse_gltf, parse_gltf_with, save_gltf, Format, LoadOptions};
 use mts::mesh::{Mesh, RawMesh, Texture};
 use mts::{Error, Place};
 use serde_json::{json, Value};
@@ -641,8 +641,8 @@ fn unsupported_and_malformed_structures_are_refused_at_their_object() {
         edit(&mut body);
         parse_error(&gltf_text(&bin, body), "t.gltf")
     };
-    // Sparse accessors.
-    let sparse = json!({ "count": 1, "indices": { "bufferView": 2, "componentType": USHORT },
+    // A sparse accessor with more substitutions than elements.
+    let sparse = json!({ "count": 4, "indices": { "bufferView": 2, "componentType": USHORT },
                          "values": { "bufferView": 0 } });
     assert_eq!(
         case(&|b| b["accessors"][0]["sparse"] = sparse.clone()),
@@ -741,4 +741,548 @@ fn corrupted_glb_bytes_never_panic() {
         }
     }
     assert!(accepted > 0);
+}
+
+// ---------------------------------------------------------------------
+// Issue 31: integers past 32 bits, asset versions, extras of any value,
+// sparse and all-zero accessors.
+
+/// The place and message of the parse error `bytes` gives.
+fn parse_failure(bytes: &[u8], name: &str) -> (Place, String) {
+    match parse_gltf(bytes, Path::new(name)) {
+        Err(Error::Parse {
+            file,
+            place,
+            message,
+        }) => {
+            assert_eq!(file, Path::new(name));
+            (place, message)
+        }
+        Err(e) => panic!("not a parse error: {e}"),
+        Ok(raw) => panic!("expected an error, got {} triangles", raw.triangles.len()),
+    }
+}
+
+/// A place naming an object of the root without index (`asset`, `root`).
+fn object(element: &str) -> Place {
+    Place {
+        element: Some(element.into()),
+        ..Place::default()
+    }
+}
+
+/// gltf-json reads indices modulo 2^32 (`"mesh": 4294967296` is mesh 0):
+/// an index or code of 2^32 or more is refused at its object, naming the
+/// field, wherever it is; 2^32 - 1 reaches the existence check; extras and
+/// extensions may hold any integer.
+#[test]
+fn indices_of_2_to_the_32_or_more_are_refused_at_their_field() {
+    let mut bin = Bin::default();
+    let mut base = triangle_asset(&mut bin);
+    let png = bin.put(PNG);
+    base["bufferViews"].as_array_mut().unwrap().push(view(png));
+    base["nodes"] = json!([{ "mesh": 0 }]);
+    base["scenes"] = json!([{ "nodes": [0] }]);
+    base["scene"] = json!(0);
+    base["images"] = json!([{ "bufferView": 3, "mimeType": "image/png" }]);
+    base["textures"] = json!([{ "source": 0 }]);
+    base["materials"] = json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }]);
+    base["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let raw = parse_gltf(&gltf_text(&bin, base.clone()), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    assert!(matches!(
+        raw.properties.texture,
+        Some(Texture::Embedded { .. })
+    ));
+
+    let big = 1u64 << 32;
+    let case = |pointer: &str, value: u64| {
+        let mut body = base.clone();
+        let (parent, key) = pointer.rsplit_once('/').unwrap();
+        let parent = body.pointer_mut(parent).unwrap();
+        match key.parse::<usize>() {
+            Ok(i) if parent.is_array() => parent[i] = json!(value),
+            _ => parent[key] = json!(value),
+        }
+        parse_failure(&gltf_text(&bin, body), "t.gltf")
+    };
+    for (pointer, place, field) in [
+        ("/nodes/0/mesh", Place::element("node", 0), "mesh"),
+        ("/scene", object("root"), "scene"),
+        ("/scenes/0/nodes/0", Place::element("scene", 0), "nodes[0]"),
+        (
+            "/meshes/0/primitives/0/attributes/POSITION",
+            Place::element("mesh", 0),
+            "primitives[0].attributes.POSITION",
+        ),
+        (
+            "/meshes/0/primitives/0/indices",
+            Place::element("mesh", 0),
+            "primitives[0].indices",
+        ),
+        (
+            "/meshes/0/primitives/0/material",
+            Place::element("mesh", 0),
+            "primitives[0].material",
+        ),
+        (
+            "/accessors/1/bufferView",
+            Place::element("accessor", 1),
+            "bufferView",
+        ),
+        (
+            "/bufferViews/2/buffer",
+            Place::element("bufferView", 2),
+            "buffer",
+        ),
+        (
+            "/materials/0/pbrMetallicRoughness/baseColorTexture/index",
+            Place::element("material", 0),
+            "pbrMetallicRoughness.baseColorTexture.index",
+        ),
+        ("/textures/0/source", Place::element("texture", 0), "source"),
+        (
+            "/images/0/bufferView",
+            Place::element("image", 0),
+            "bufferView",
+        ),
+    ] {
+        let (at, message) = case(pointer, big);
+        assert_eq!(at, place, "{pointer}");
+        assert_eq!(
+            message,
+            format!("{field} 4294967296 is not an index"),
+            "{pointer}"
+        );
+        // Far past 2^32 too (2^32 + 1 would be index 1).
+        let (at, message) = case(pointer, u64::MAX);
+        assert_eq!(at, place, "{pointer}");
+        assert!(
+            message.starts_with(&format!("{field} {} ", u64::MAX)),
+            "{message}"
+        );
+    }
+    // Node children, and the codes: componentType 2^32 + FLOAT, mode 2^32 + 4.
+    let mut body = base.clone();
+    body["nodes"] = json!([{ "children": [1] }, { "mesh": 0 }]);
+    body["nodes"][0]["children"][0] = json!(big + 1);
+    assert_eq!(
+        parse_failure(&gltf_text(&bin, body), "t.gltf"),
+        (
+            Place::element("node", 0),
+            "children[0] 4294967297 is not an index".into()
+        )
+    );
+    let (at, message) = case("/accessors/0/componentType", big + u64::from(FLOAT));
+    assert_eq!(at, Place::element("accessor", 0));
+    assert!(
+        message.starts_with("componentType 4294972422 is not a valid value"),
+        "{message}"
+    );
+    let (at, message) = case("/meshes/0/primitives/0/mode", big + 4);
+    assert_eq!(at, Place::element("mesh", 0));
+    assert!(
+        message.starts_with("primitives[0].mode 4294967300 is not"),
+        "{message}"
+    );
+    // Sparse views, in a .glb: the place is the object, no byte.
+    let mut body = base.clone();
+    body["accessors"][0]["sparse"] = json!({ "count": 1,
+        "indices": { "bufferView": big, "componentType": USHORT },
+        "values": { "bufferView": 0 } });
+    assert_eq!(
+        parse_failure(&glb(&bin, body).0, "t.glb"),
+        (
+            Place::element("accessor", 0),
+            "sparse.indices.bufferView 4294967296 is not an index".into()
+        )
+    );
+    // 2^32 - 1 is an index, of no mesh.
+    let (at, message) = case("/nodes/0/mesh", big - 1);
+    assert_eq!(at, Place::element("node", 0));
+    assert!(
+        message.contains("mesh 4294967295 does not exist"),
+        "{message}"
+    );
+    // Any integer in extras and extensions; sizes are 64-bit, checked
+    // against the data.
+    let mut body = base.clone();
+    body["nodes"][0]["extras"] = json!({ "mesh": u64::MAX, "big": [big] });
+    body["nodes"][0]["extensions"] = json!({ "X_made_up": { "mesh": big } });
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    let (at, message) = case("/accessors/0/count", big);
+    assert_eq!(at, Place::element("accessor", 0));
+    assert!(
+        message.starts_with("4294967296 elements of 12 bytes"),
+        "{message}"
+    );
+}
+
+/// `body` as a `.gltf` (buffer 0 `bin` as a data URI) with `asset`.
+fn gltf_with_asset(bin: &Bin, body: Value, asset: Value) -> Vec<u8> {
+    let mut document: Value = serde_json::from_slice(&gltf_text(bin, body)).unwrap();
+    document["asset"] = asset;
+    serde_json::to_vec(&document).unwrap()
+}
+
+/// A loader must refuse a major version it does not know (glTF 2.0,
+/// "Asset"), and a minVersion above what it reads: 1.0, 3.0 and
+/// minVersion 2.1 are refused at `asset`; 2.1 with minVersion 2.0 is read.
+#[test]
+fn asset_versions_other_than_2_are_refused_at_the_asset() {
+    let mut bin = Bin::default();
+    let body = triangle_asset(&mut bin);
+    let read = |asset: Value| {
+        parse_gltf(
+            &gltf_with_asset(&bin, body.clone(), asset),
+            Path::new("t.gltf"),
+        )
+    };
+    let raw = read(json!({ "version": "2.1", "minVersion": "2.0" })).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    assert_eq!(
+        read(json!({ "version": "2.0" })).unwrap().positions.len(),
+        3
+    );
+    for (asset, expected) in [
+        (
+            json!({ "version": "1.0" }),
+            "version \"1.0\": glTF 1.x is not read, only 2.x",
+        ),
+        (
+            json!({ "version": "3.0" }),
+            "version \"3.0\": glTF 3.x is not read, only 2.x",
+        ),
+        (
+            json!({ "version": "2" }),
+            "version \"2\" is not MAJOR.MINOR",
+        ),
+        (
+            json!({ "version": "2.1", "minVersion": "2.1" }),
+            "minVersion \"2.1\": the asset needs a reader of glTF 2.1, this one reads 2.0",
+        ),
+        (
+            json!({ "version": "3.0", "minVersion": "3.0" }),
+            "version \"3.0\": glTF 3.x is not read, only 2.x",
+        ),
+    ] {
+        match read(asset.clone()) {
+            Err(Error::Parse { place, message, .. }) => {
+                assert_eq!(place, object("asset"), "{asset}");
+                assert_eq!(message, expected);
+            }
+            other => panic!("{asset}: expected a parse error, got {other:?}"),
+        }
+    }
+    // A glTF 1.0 document (objects by name, not arrays) is refused for its
+    // version, not for its shape.
+    let old = br#"{ "asset": { "version": "1.0" }, "meshes": { "m": { "primitives": [] } } }"#;
+    assert_eq!(parse_failure(old, "t.gltf").0, object("asset"));
+}
+
+/// The specification lets `extras` be any JSON value: arrays, strings,
+/// numbers and null are read past, at the root and on every object.
+#[test]
+fn extras_of_any_json_value_are_accepted() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["nodes"] = json!([{ "mesh": 0 }]);
+    body["scenes"] = json!([{ "nodes": [0] }]);
+    body["materials"] = json!([{ "pbrMetallicRoughness": { "baseColorFactor": [1, 1, 1, 1] } }]);
+    body["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let plain = parse_gltf(&gltf_text(&bin, body.clone()), Path::new("t.gltf")).unwrap();
+    let places = [
+        "",
+        "/nodes/0",
+        "/scenes/0",
+        "/meshes/0",
+        "/meshes/0/primitives/0",
+        "/accessors/0",
+        "/accessors/2",
+        "/bufferViews/1",
+        "/materials/0",
+        "/materials/0/pbrMetallicRoughness",
+    ];
+    for extras in [
+        json!([1, 2, 3]),
+        json!("hello"),
+        json!(3),
+        json!(null),
+        json!([]),
+    ] {
+        let mut body = body.clone();
+        for place in places {
+            body.pointer_mut(place).unwrap()["extras"] = extras.clone();
+        }
+        let mut document: Value = serde_json::from_slice(&gltf_text(&bin, body)).unwrap();
+        document["asset"]["extras"] = extras.clone();
+        document["buffers"][0]["extras"] = extras.clone();
+        let raw = parse_gltf(&serde_json::to_vec(&document).unwrap(), Path::new("t.gltf"))
+            .unwrap_or_else(|e| panic!("extras {extras}: {e}"));
+        assert_eq!(raw.positions, plain.positions);
+        assert_eq!(raw.triangles, [[0, 1, 2]]);
+        assert_eq!(raw.properties.normals, plain.properties.normals);
+    }
+    // A glTF mistake in a file with such extras still names its line
+    // where it comes first, and is still refused where it comes after.
+    let text = "{\n\"asset\": { \"version\": \"2.0\" },\n\
+                \"accessors\": [{ \"componentType\": 5126, \"type\": \"VEC3\", \"count\": \"three\" }],\n\
+                \"extras\": [1]\n}";
+    let (place, message) = parse_failure(text.as_bytes(), "t.gltf");
+    assert_eq!(place, Place::line(3));
+    assert!(message.contains("\"three\""), "{message}");
+    let text = "{\n\"asset\": { \"version\": \"2.0\", \"extras\": [1] },\n\
+                \"accessors\": [{ \"componentType\": 5126, \"type\": \"VEC3\", \"count\": \"three\" }]\n}";
+    let (place, message) = parse_failure(text.as_bytes(), "t.gltf");
+    assert_eq!(place, Place::default());
+    assert!(message.contains("\"three\""), "{message}");
+}
+
+//  3 - 2       a square whose vertices 1 and 3 are sparse substitutions
+//  |   |       (u8 indices from byte 1 of their view) over a base view
+//  0 - 1       holding 9s; normals all zero but vertex 2's (u16 index,
+//              no bufferView); UV 0 substituted (u32 index); colours zero
+//              but vertex 3's red (no bufferView, normalised u8); the
+//              triangle list's last index substituted: (0 1 2) (0 2 3).
+fn sparse_asset(bin: &mut Bin) -> Value {
+    let p = bin.f32s(&[0., 0., 0., 9., 9., 9., 1., 1., 0., 9., 9., 9.]);
+    let pi = bin.put(&[7, 1, 3]);
+    let pv = bin.f32s(&[1., 0., 0., 0., 1., 0.]);
+    let ni = bin.u16s(&[2]);
+    let nv = bin.f32s(&[0., 0., 1.]);
+    let t = bin.f32s(&[0., 0., 1., 0., 1., 1., 0., 1.]);
+    let ti = bin.put(&0u32.to_le_bytes());
+    let tv = bin.f32s(&[0.5, 0.25]);
+    let ci = bin.put(&[3]);
+    let cv = bin.put(&[255, 0, 0, 255]);
+    let i = bin.u16s(&[0, 1, 2, 0, 2, 2]);
+    let ii = bin.put(&[5]);
+    let iv = bin.u16s(&[3]);
+    let sparse = |count: usize, indices: usize, component: u32, values: usize| {
+        json!({ "count": count, "indices": { "bufferView": indices, "componentType": component },
+                "values": { "bufferView": values } })
+    };
+    let mut positions = accessor(0, FLOAT, "VEC3", 4);
+    positions["sparse"] = sparse(2, 1, UBYTE, 2);
+    positions["sparse"]["indices"]["byteOffset"] = json!(1);
+    let normals = json!({ "componentType": FLOAT, "type": "VEC3", "count": 4,
+                          "sparse": sparse(1, 3, USHORT, 4) });
+    let mut uvs = accessor(5, FLOAT, "VEC2", 4);
+    uvs["sparse"] = sparse(1, 6, UINT, 7);
+    let colors = json!({ "componentType": UBYTE, "type": "VEC4", "count": 4, "normalized": true,
+                         "sparse": sparse(1, 8, UBYTE, 9) });
+    let mut indices = accessor(10, USHORT, "SCALAR", 6);
+    indices["sparse"] = sparse(1, 11, UBYTE, 12);
+    let views = [p, pi, pv, ni, nv, t, ti, tv, ci, cv, i, ii, iv].map(view);
+    json!({
+        "bufferViews": views,
+        "accessors": [positions, normals, uvs, colors, indices],
+        "meshes": [{ "primitives": [{
+            "attributes": { "POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "COLOR_0": 3 },
+            "indices": 4,
+        }] }],
+    })
+}
+
+const UINT: u32 = 5125;
+
+#[test]
+fn sparse_accessors_substitute_their_values() {
+    let mut bin = Bin::default();
+    let body = sparse_asset(&mut bin);
+    let v = Vec3::new;
+    for (file, name) in [
+        (gltf_text(&bin, body.clone()), "t.gltf"),
+        (glb(&bin, body.clone()).0, "t.glb"),
+    ] {
+        let raw = parse_gltf(&file, Path::new(name)).unwrap();
+        assert_eq!(
+            raw.positions,
+            [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)]
+        );
+        assert_eq!(raw.triangles, [[0, 1, 2], [0, 2, 3]]);
+        let p = &raw.properties;
+        assert_eq!(
+            p.normals.as_deref().unwrap(),
+            [Vec3::ZERO, Vec3::ZERO, Vec3::Z, Vec3::ZERO]
+        );
+        // v flipped: 1 - v.
+        assert_eq!(
+            p.uvs.as_deref().unwrap(),
+            [
+                Vec2::new(0.5, 0.75),
+                Vec2::new(1., 1.),
+                Vec2::new(1., 0.),
+                Vec2::new(0., 0.)
+            ]
+        );
+        assert_eq!(
+            p.colors.as_deref().unwrap(),
+            [
+                Vec4::ZERO,
+                Vec4::ZERO,
+                Vec4::ZERO,
+                Vec4::new(1., 0., 0., 1.)
+            ]
+        );
+    }
+    let (mesh, report) = load_bytes(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert_eq!(mesh.triangles.len(), 2);
+    assert_eq!(report.degenerate_dropped, 0);
+}
+
+fn load_bytes(bytes: &[u8], path: &Path) -> mts::Result<(Mesh, mts::mesh::CleanReport)> {
+    mts::mesh::io::load_bytes(bytes, path, LoadOptions::default())
+}
+
+/// Every sparse mistake is refused at its accessor, with the byte of the
+/// offending index or value in a `.glb`.
+#[test]
+fn bad_sparse_accessors_are_refused_with_their_byte() {
+    let mut bin = Bin::default();
+    let body = sparse_asset(&mut bin);
+    let offset = |v: usize| body["bufferViews"][v]["byteOffset"].as_u64().unwrap();
+    let failure = |bin: &Bin, body: &Value| {
+        let (file, bin_at) = glb(bin, body.clone());
+        let (place, message) = parse_failure(&file, "t.glb");
+        (place, message, bin_at)
+    };
+    // Indices not increasing: 3 then 1, at byte 2 of view 1.
+    let mut bad = Bin(bin.0.clone());
+    bad.0[offset(1) as usize + 1..][..2].copy_from_slice(&[3, 1]);
+    let (place, message, bin_at) = failure(&bad, &body);
+    assert_eq!(place, at("accessor", 0, Some(bin_at + offset(1) + 2)));
+    assert!(
+        message.starts_with("sparse index 1 is 1, not above sparse index 0 (3)"),
+        "{message}"
+    );
+    // An index past the accessor's count.
+    let mut bad = Bin(bin.0.clone());
+    bad.0[offset(1) as usize + 2] = 4;
+    let (place, message, bin_at) = failure(&bad, &body);
+    assert_eq!(place, at("accessor", 0, Some(bin_at + offset(1) + 2)));
+    assert!(
+        message.starts_with("sparse index 1 is 4, the accessor has 4 elements"),
+        "{message}"
+    );
+    // A substituted index past the vertex count.
+    let mut bad = Bin(bin.0.clone());
+    bad.0[offset(12) as usize] = 4;
+    let (place, message, bin_at) = failure(&bad, &body);
+    assert_eq!(place, at("accessor", 4, Some(bin_at + offset(12))));
+    assert!(
+        message.starts_with("sparse value 0 (index 5) is 4, the primitive has 4 vertices"),
+        "{message}"
+    );
+    // A substituted NaN: component 1 of value 1.
+    let mut bad = Bin(bin.0.clone());
+    bad.0[offset(2) as usize + 16..][..4].copy_from_slice(&f32::NAN.to_le_bytes());
+    let (place, message, bin_at) = failure(&bad, &body);
+    assert_eq!(place, at("accessor", 0, Some(bin_at + offset(2) + 16)));
+    assert!(
+        message.starts_with("component 1 of sparse value 1 (element 3) is NaN"),
+        "{message}"
+    );
+    // Three indices from byte 1 of a 3-byte view; three values in a view
+    // of two.
+    let mut long = body.clone();
+    long["accessors"][0]["sparse"]["count"] = json!(3);
+    let (place, message, bin_at) = failure(&bin, &long);
+    assert_eq!(place, at("accessor", 0, Some(bin_at + offset(1) + 1)));
+    assert!(
+        message.starts_with("sparse.indices: 3 elements of 1 bytes"),
+        "{message}"
+    );
+    long["accessors"][0]["sparse"]["indices"]["byteOffset"] = json!(0);
+    let (place, message, bin_at) = failure(&bin, &long);
+    assert_eq!(place, at("accessor", 0, Some(bin_at + offset(2))));
+    assert!(
+        message.starts_with("sparse.values: 3 elements of 12 bytes"),
+        "{message}"
+    );
+    // More substitutions than elements; float indices.
+    let mut bad = body.clone();
+    bad["accessors"][1]["sparse"]["count"] = json!(5);
+    assert_eq!(failure(&bin, &bad).0, Place::element("accessor", 1));
+    let mut bad = body.clone();
+    bad["accessors"][1]["sparse"]["indices"]["componentType"] = json!(FLOAT);
+    let (place, message, _) = failure(&bin, &bad);
+    assert_eq!(place, Place::element("accessor", 1));
+    assert!(
+        message.contains("sparse.indices.componentType"),
+        "{message}"
+    );
+    // Sparse indices in a view that does not exist.
+    let mut bad = body.clone();
+    bad["accessors"][2]["sparse"]["indices"]["bufferView"] = json!(99);
+    assert_eq!(failure(&bin, &bad).0, Place::element("accessor", 2));
+}
+
+/// An accessor with neither bufferView nor sparse reads as zeros: three
+/// coincident points make one triangle of no area, which the cleaning
+/// step's weld makes degenerate, then reports no triangle left. Nothing
+/// bounds such a
+/// count but the caller's limit: three times its triangles.
+#[test]
+fn accessors_without_buffer_view_are_zeros_within_the_limit() {
+    let body = json!({
+        "accessors": [{ "componentType": FLOAT, "type": "VEC3", "count": 3 }],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 } }] }],
+    });
+    let file = gltf_text(&Bin::default(), body.clone());
+    let raw = parse_gltf(&file, Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.positions, [Vec3::ZERO; 3]);
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    // Kept apart, the three vertices make a triangle of no area; welded,
+    // none is left.
+    let (mesh, _) = load_bytes(&file, Path::new("t.gltf")).unwrap();
+    assert_eq!(mesh.triangles, [[0, 1, 2]]);
+    let weld = LoadOptions {
+        clean: mts::mesh::CleanOptions { weld: true },
+        ..LoadOptions::default()
+    };
+    match mts::mesh::io::load_bytes(&file, Path::new("t.gltf"), weld).unwrap_err() {
+        Error::InvalidMesh { source_name, .. } => assert_eq!(source_name, "t.gltf"),
+        other => panic!("expected an invalid-mesh error, got {other:?}"),
+    }
+    // Limit 10 triangles: 30 zero vertices are read, 31 refused.
+    let zeros = |count: u64, limit: u64| {
+        let mut body = body.clone();
+        body["accessors"][0]["count"] = json!(count);
+        parse_gltf_with(
+            &gltf_text(&Bin::default(), body),
+            Path::new("t.gltf"),
+            limit,
+        )
+    };
+    assert_eq!(zeros(30, 10).unwrap().positions.len(), 30);
+    for (count, limit) in [(31, 10), (u64::MAX, mts::mesh::io::DEFAULT_MAX_TRIANGLES)] {
+        match zeros(count, limit) {
+            Err(Error::Parse { place, message, .. }) => {
+                assert_eq!(place, Place::element("accessor", 0));
+                assert!(
+                    message.starts_with(&format!("no bufferView: {count} elements of zeros")),
+                    "{message}"
+                );
+            }
+            other => panic!("expected a parse error, got {other:?}"),
+        }
+    }
+    // Zero indices: a triangle list of the first vertex, within the limit.
+    let mut body = body.clone();
+    body["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "componentType": USHORT, "type": "SCALAR", "count": 6 }));
+    body["meshes"][0]["primitives"][0]["indices"] = json!(1);
+    let file = gltf_text(&Bin::default(), body.clone());
+    assert_eq!(
+        parse_gltf(&file, Path::new("t.gltf")).unwrap().triangles,
+        [[0, 0, 0], [0, 0, 0]]
+    );
+    body["accessors"][1]["count"] = json!(1u64 << 40);
+    let (place, message) = parse_failure(&gltf_text(&Bin::default(), body), "t.gltf");
+    assert_eq!(place, Place::element("accessor", 1));
+    assert!(message.starts_with("no bufferView"), "{message}");
 }

@@ -574,3 +574,90 @@ fn real_models_hold_the_invariant() {
         verify_model(&name, &mesh);
     }
 }
+
+/// Issue 31, item 8: a ready file whose records were changed and the file
+/// resealed (checksum recomputed) must not load and draw other triangles
+/// than its recipe. Every record's vertex plus one, and every entry of the
+/// LoD → triangle table plus one, is refused; a label changed is refused
+/// or draws the recipe's triangles at every band's first LoD (what loading
+/// checks; `model/digest.rs` says what is left to `mts verify`).
+#[test]
+fn resealed_ready_models_that_lie_are_refused() {
+    let good = small_file();
+    let modl = section(&good, b"MODL");
+    let mut at = modl;
+    let mut counts = [0usize; 5];
+    for c in &mut counts {
+        let (mut v, mut shift) = (0usize, 0);
+        loop {
+            let b = good[at];
+            at += 1;
+            v |= usize::from(b & 0x7f) << shift;
+            shift += 7;
+            if b & 0x80 == 0 {
+                break;
+            }
+        }
+        *c = v;
+    }
+    let [strips, bands, begins, records, far] = counts;
+    let (vw, lw) = (usize::from(good[at]), usize::from(good[at + 1]));
+    assert_eq!((vw, lw, far), (2, 2, 0), "the layout this test reads");
+    let vertices = at + 2 + 4 * (2 * bands + 1 + 3 * strips + 2 + 2 * begins);
+    let labels = vertices + vw * records;
+    let codes = labels + lw * records;
+    let table = codes + records + 8 * far;
+    let model = MtsModel::from_bytes(&good, Path::new("good.mts")).unwrap();
+    let add_one = |at: usize| {
+        let mut b = good.clone();
+        let v = u16::from_le_bytes([b[at], b[at + 1]]).wrapping_add(1);
+        b[at..at + 2].copy_from_slice(&v.to_le_bytes());
+        seal(&mut b);
+        b
+    };
+    let mesh = model.mesh();
+    let all: Vec<usize> = (0..=model.max_lod()).collect();
+    // Each change: refused, harmless (the model still draws the recipe's
+    // triangles at every LoD: a field no walk reads), or a lie.
+    let judge = |bytes: &[u8]| match MtsModel::from_bytes(bytes, Path::new("bad.mts")) {
+        Err(e) => {
+            assert!(e.to_string().contains("MODL"), "{e}");
+            0
+        }
+        Ok(m) => {
+            if mts::model::verify(&m, &mesh, &all).mismatches == 0 {
+                1
+            } else {
+                2
+            }
+        }
+    };
+    // Only records that start a node name a vertex (later arcs of a node
+    // repeat nothing).
+    let mut vertex = [0; 3];
+    for r in 0..records {
+        if r == 0 || good[codes + r - 1] & 0x80 == 0 {
+            vertex[judge(&add_one(vertices + 2 * r))] += 1;
+        }
+    }
+    let mut label = [0; 3];
+    for r in 0..records {
+        label[judge(&add_one(labels + 2 * r))] += 1;
+    }
+    eprintln!("vertex changes refused/harmless/lies {vertex:?}, labels {label:?}");
+    for lod in 0..=model.max_lod() {
+        let b = {
+            let mut b = good.clone();
+            let at = table + 4 * lod;
+            let v = u32::from_le_bytes(b[at..at + 4].try_into().unwrap()).wrapping_add(1);
+            b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+            seal(&mut b);
+            b
+        };
+        assert!(
+            MtsModel::from_bytes(&b, Path::new("table.mts")).is_err(),
+            "table entry {lod} plus one accepted"
+        );
+    }
+    assert!(vertex[0] > 300);
+}

@@ -64,6 +64,43 @@ impl Mesh {
         self.triangles.len()
     }
 
+    /// A mesh of `positions` and `properties` (of the same vertices) with
+    /// only the vertices `triangles` use, renumbered in their order: what
+    /// a level of detail is when it is exported (a LoD of a model names
+    /// its vertices by the full mesh's numbers, most of them unused at a
+    /// coarse level). Position ids are renumbered densely
+    /// ([`Properties::gather`]).
+    ///
+    /// # Panics
+    /// If a triangle names a vertex past `positions`, or a property stream
+    /// has another length than `positions`.
+    ///
+    /// Cost: O(vertices + triangles).
+    #[must_use]
+    pub fn level(positions: &[Vec3], triangles: &[[u32; 3]], properties: &Properties) -> Mesh {
+        const UNUSED: u32 = u32::MAX;
+        let mut remap = vec![UNUSED; positions.len()];
+        let mut order = Vec::new();
+        let triangles = triangles
+            .iter()
+            .map(|t| {
+                t.map(|v| {
+                    let r = &mut remap[v as usize];
+                    if *r == UNUSED {
+                        *r = order.len() as u32;
+                        order.push(v);
+                    }
+                    *r
+                })
+            })
+            .collect();
+        Mesh {
+            positions: order.iter().map(|&v| positions[v as usize]).collect(),
+            triangles,
+            properties: properties.gather(&order),
+        }
+    }
+
     /// The triangles as a flat `u32` index list (3 per triangle).
     #[must_use]
     pub fn index_list(&self) -> Vec<u32> {

@@ -239,15 +239,12 @@ impl MtsModel {
     }
 
     /// Writes the model to `path`, ready to walk (see
-    /// [`MtsModel::to_bytes`]).
+    /// [`MtsModel::to_bytes`]), whole or not at all ([`crate::output`]).
     ///
     /// # Errors
     /// [`Error::Io`] if the file cannot be written.
     pub fn save(&self, path: &Path) -> Result<()> {
-        std::fs::write(path, self.to_bytes()).map_err(|source| Error::Io {
-            file: path.to_owned(),
-            source,
-        })
+        crate::output::write_file(path, &self.to_bytes())
     }
 
     /// Reads a model from `path` (see [`MtsModel::from_bytes`]).
@@ -290,7 +287,7 @@ impl MtsModel {
         let at = parsed.modl.as_ref().map_or(0, |m| m.base);
         let model = assemble(arrays?, parsed);
         model
-            .validate()
+            .validate_against_recipe()
             .map_err(|e| parse_error(file, at, "MODL", e.message))?;
         Ok(model)
     }

@@ -28,6 +28,7 @@
 //!   steps as the strip has records, even on a corrupt model.
 
 mod build;
+mod digest;
 mod extract;
 pub mod format;
 mod pipeline;
@@ -321,13 +322,85 @@ impl MtsModel {
     /// # Errors
     /// [`crate::Invalid`] naming the first broken one (strip, node or arc).
     pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
-        self.check_parts().map_err(|message| crate::Invalid {
-            structure: "MtsModel",
-            message,
-        })
+        let key = digest::TriangleKey::random();
+        let first: Vec<Vec<u32>> = self.band_lod.iter().map(|&l| vec![l]).collect();
+        self.check_parts(&key, &first)
+            .map(drop)
+            .map_err(|message| crate::Invalid {
+                structure: "MtsModel",
+                message,
+            })
     }
 
-    fn check_parts(&self) -> Result<(), String> {
+    /// [`MtsModel::validate`], and that the model draws what its recipe
+    /// replays at the first LoD of every band, with the recipe's triangle
+    /// count at every LoD: what loading a ready `.mts` checks (the
+    /// decision and what it leaves to trust: `model/digest.rs`).
+    ///
+    /// # Errors
+    /// [`crate::Invalid`] naming the first broken invariant, or the band
+    /// (or LoD) where the model and its recipe disagree.
+    ///
+    /// Cost: [`MtsModel::validate`]'s, with the recipe's replay (O(triangles
+    /// + the triangles the contractions move)) on a second thread.
+    pub fn validate_against_recipe(&self) -> std::result::Result<(), crate::Invalid> {
+        let key = digest::TriangleKey::random();
+        let samples = self.band_samples(&key);
+        let flat: Vec<u32> = samples.iter().flatten().copied().collect();
+        let (walked, replayed) = std::thread::scope(|scope| {
+            let replay = scope.spawn(|| digest::replay_digests(self, &key, &flat));
+            let walked = self.check_parts(&key, &samples);
+            let replayed = replay
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e));
+            (walked, replayed)
+        });
+        let invalid = |message| crate::Invalid {
+            structure: "MtsModel",
+            message,
+        };
+        let (walked, replayed) = (walked.map_err(invalid)?, replayed.map_err(invalid)?);
+        let mut replayed = replayed.iter();
+        for (b, (lods, walked)) in samples.iter().zip(&walked).enumerate() {
+            for (lod, (w, r)) in lods.iter().zip(walked.iter().zip(replayed.by_ref())) {
+                if w != r {
+                    return Err(invalid(format!(
+                        "band {b}: its strips draw {} triangles at LoD {lod}, {} the \
+                         recipe's replay has",
+                        w.count,
+                        if w.count == r.count {
+                            "other triangles than"
+                        } else {
+                            "not as many as"
+                        }
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Per band, the LoDs [`MtsModel::validate_against_recipe`] compares
+    /// ([`digest::TriangleKey::band_samples`]).
+    fn band_samples(&self, key: &digest::TriangleKey) -> Vec<Vec<u32>> {
+        let max_lod = self.max_lod() as u32;
+        (0..self.band_count())
+            .map(|b| {
+                let first = self.band_lod[b];
+                let last = self.band_lod.get(b + 1).map_or(max_lod, |&next| next - 1);
+                key.band_samples(b, first, last.max(first))
+            })
+            .collect()
+    }
+
+    /// The structure checks; returns, per band, the digest of the
+    /// triangles its strips draw at each of its `samples` (LoDs of the band,
+    /// ascending), hashed with `key`.
+    fn check_parts(
+        &self,
+        key: &digest::TriangleKey,
+        samples: &[Vec<u32>],
+    ) -> Result<Vec<Vec<digest::Digest>>, String> {
         let max_lod = self.max_lod() as u32;
         let records = self.rec_code.len();
         check_offsets("strip record", &self.strip_records, records)?;
@@ -380,15 +453,19 @@ impl MtsModel {
             );
         }
         cuts.push(self.strip_count());
-        let results: Vec<Result<usize, String>> = if threads == 1 {
-            vec![self.check_strips(0..self.strip_count(), &births)]
+        if samples.len() != self.band_count() {
+            return Err("band tables disagree".into());
+        }
+        type Checked = Result<(usize, Vec<Vec<digest::Digest>>), String>;
+        let results: Vec<Checked> = if threads == 1 {
+            vec![self.check_strips(0..self.strip_count(), &births, key, samples)]
         } else {
             std::thread::scope(|scope| {
                 let handles: Vec<_> = cuts
                     .windows(2)
                     .map(|w| {
                         let (range, births) = (w[0]..w[1], &births);
-                        scope.spawn(move || self.check_strips(range, births))
+                        scope.spawn(move || self.check_strips(range, births, key, samples))
                     })
                     .collect();
                 handles
@@ -398,22 +475,35 @@ impl MtsModel {
             })
         };
         let mut far_arcs = 0;
+        let mut digests: Vec<Vec<digest::Digest>> =
+            samples.iter().map(|l| vec![digest::Digest::default(); l.len()]).collect();
         for r in results {
-            far_arcs += r?;
+            let (far, chunk) = r?;
+            far_arcs += far;
+            for (band, c) in digests.iter_mut().zip(chunk) {
+                for (d, c) in band.iter_mut().zip(c) {
+                    d.merge(c);
+                }
+            }
         }
         if far_arcs != self.far.len() {
             return Err("the far table names a record whose arc is not far".into());
         }
-        Ok(())
+        Ok(digests)
     }
 
     /// Checks strips `strips` (beginnings, records, slot sizes); returns
-    /// how many far arcs they hold.
+    /// how many far arcs they hold, and per band the digest of the
+    /// triangles they draw at each of the band's `samples`.
     fn check_strips(
         &self,
         strips: std::ops::Range<usize>,
         births: &[u32],
-    ) -> Result<usize, String> {
+        key: &digest::TriangleKey,
+        samples: &[Vec<u32>],
+    ) -> Result<(usize, Vec<Vec<digest::Digest>>), String> {
+        let mut digests: Vec<Vec<digest::Digest>> =
+            samples.iter().map(|l| vec![digest::Digest::default(); l.len()]).collect();
         let max_lod = self.max_lod() as u32;
         let vertices = self.positions.len() as u32;
         let first_record = self.strip_records[strips.start];
@@ -464,8 +554,24 @@ impl MtsModel {
                     self.slot_size[s], w.len
                 ));
             }
+            let band = self.band_strips.partition_point(|&first| first as usize <= s) - 1;
+            for (&lod, d) in samples[band].iter().zip(&mut digests[band]) {
+                let len = if lod == birth {
+                    w.len
+                } else {
+                    let at = extract::walk(self, s, birth, lod, &mut scratch);
+                    if at.overflow || at.len > self.slot_size[s] {
+                        return Err(format!(
+                            "strip {s}: its walk at LoD {lod} overflows its slot of {}",
+                            self.slot_size[s]
+                        ));
+                    }
+                    at.len
+                };
+                d.merge(key.digest_of_runs(&scratch[..len as usize]));
+            }
         }
-        Ok(self.far.len() - far_start - far.len())
+        Ok((self.far.len() - far_start - far.len(), digests))
     }
 }
 

@@ -467,11 +467,7 @@ impl Collapses {
             .chain(&self.appended)
             .copied()
             .collect();
-        let (mut out, order) = compact(&all, &triangles);
-        if let Some(p) = self.properties(mesh) {
-            out.properties = p.gather(&order);
-        }
-        out
+        Mesh::level(&all, &triangles, &self.properties(mesh).unwrap_or_default())
     }
 
     /// Checks the invariants listed on [`Collapses`].
@@ -586,34 +582,4 @@ impl Collapses {
         }
         Ok(())
     }
-}
-
-/// `triangles` over `positions` with unreferenced vertices dropped, and
-/// the old vertex of each new one.
-fn compact(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Mesh, Vec<u32>) {
-    let mut map = vec![u32::MAX; positions.len()];
-    let mut out = Vec::new();
-    let mut order = Vec::new();
-    let triangles = triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                let slot = &mut map[v as usize];
-                if *slot == u32::MAX {
-                    *slot = out.len() as u32;
-                    out.push(positions[v as usize]);
-                    order.push(v);
-                }
-                *slot
-            })
-        })
-        .collect();
-    (
-        Mesh {
-            positions: out,
-            triangles,
-            properties: Default::default(),
-        },
-        order,
-    )
 }

@@ -15,7 +15,10 @@
 //! Attributes `POSITION`, `NORMAL`, `TEXCOORD_0` (`v` flipped to point up
 //! the image: `v = 1 - v_gltf`), `COLOR_0` (vec3 or vec4, float or
 //! normalised integers; vec3 gets alpha 1) and the indices (u8, u16, u32, or
-//! none: vertices in order). Triangle strips and fans become triangles of
+//! none: vertices in order), from dense or sparse accessors (the base
+//! values from the buffer view, or zeros without one, then the
+//! substitutions: "Sparse Accessors"); an accessor with neither buffer view
+//! nor `sparse` reads as zeros. Triangle strips and fans become triangles of
 //! the same winding; points and lines are skipped with a note on stderr.
 //! Not read: skins, morph targets, animations, cameras, texture sets other
 //! than 0, tangents, textures other than the base colour.
@@ -38,24 +41,42 @@
 //! coordinate `(0, 0)`, colour white (times the material's factor). A
 //! stream no primitive has stays absent.
 //!
-//! **Checks.** Every index followed (scene, node, mesh, accessor, buffer
-//! view, buffer, material, texture, image) is checked before use, so the
-//! `gltf` crate's own `validate`, whose primitive hook indexes the accessor
-//! list before the range is checked (a panic on a bad `POSITION` index), is
-//! not called. Accessor ranges (`offset + stride * (count - 1) + element`)
-//! are checked against their buffer view and views against their buffer
-//! before anything is allocated; index values against the primitive's
-//! vertex count; floats for finiteness; GLB chunks against the file length;
-//! data URIs for base64. Sparse accessors and accessors without a buffer
-//! view (all zeros) are refused. Node hierarchies must be trees (a node
-//! reached twice is an error, so cycles end), walked without recursion. All
-//! instances together may hold at most [`MAX_INSTANCED`] vertices and as
-//! many triangles. Errors are [`Error::Parse`] naming the glTF file and the
-//! JSON object (`accessor 3`, `node 2`, `mesh 0 primitive 1`); `byte` is an
-//! offset in that file when the data lies in it (the BIN chunk of a
-//! `.glb`), and for data in a `.bin` file or a data URI the message gives
-//! the buffer and its offset. An external buffer that cannot be read is
-//! [`Error::Io`] naming that file.
+//! **Checks.** The JSON is first read as a `serde_json::Value` (a syntax
+//! error names its line), where what the typed model (gltf-json) would
+//! let through is refused: an `asset.version` whose major is not 2 and an
+//! `asset.minVersion` above 2.0 (a loader must refuse a major version it
+//! does not know), and an integer of 2^32 or more where the schema wants
+//! an index or a code, outside `extras` and `extensions` (the model reads
+//! those modulo 2^32: `"mesh": 4294967296` would be mesh 0). The model
+//! takes only an object as `extras`, which the specification lets be any
+//! JSON value: a document the model refuses is tried again with every
+//! `extras` dropped (its error then has a line only where the first try
+//! failed with the same message). Every index followed (scene, node, mesh,
+//! accessor, buffer view, buffer, material, texture, image) is checked
+//! before use, so the `gltf` crate's own `validate`, whose primitive hook
+//! indexes the accessor list before the range is checked (a panic on a bad
+//! `POSITION` index), is not called. Accessor ranges (`offset + stride *
+//! (count - 1) + element`, sparse indices and values tightly packed) are
+//! checked against their buffer view and views against their buffer before
+//! anything is allocated; an accessor without buffer view, which no bytes
+//! bound, may have at most three times the caller's triangle limit of
+//! elements; sparse indices must strictly increase and stay below the
+//! accessor's count; index values are checked against the primitive's
+//! vertex count; floats for finiteness; GLB chunks against the file
+//! length; data URIs for base64. Node hierarchies must be trees (a node
+//! reached twice is an error, so cycles end), walked without recursion.
+//! All instances together may hold at most the caller's triangle limit
+//! ([`super::LoadOptions::max_triangles`]) and three times as many
+//! vertices: a 250 KB file that places a 10,000-triangle mesh under 2,000
+//! nodes asks for 20 M triangles, and is refused at the primitive that
+//! passes the limit, before its copy is made. Errors are [`Error::Parse`]
+//! naming the glTF file and the JSON object (`accessor 3`, `node 2`,
+//! `mesh 0 primitive 1`, `asset`), the message the field where the place
+//! alone does not (`sparse index 2 is 7, ...`); `byte` is an offset in
+//! that file when the data lies in it (the BIN chunk of a `.glb`), and for
+//! data in a `.bin` file or a data URI the message gives the buffer and
+//! its offset. An external buffer that cannot be read is [`Error::Io`]
+//! naming that file.
 //!
 //! Position ids are left empty: glTF has no notion of one point split at a
 //! seam (vertices are split per primitive and per attribute value alike);
@@ -69,16 +90,10 @@ use gltf::json;
 use gltf::json::accessor::{ComponentType, Type};
 use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::Checked;
+use serde_json::Value;
 use std::borrow::Cow;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
-
-/// Most vertices (and, separately, triangles) all instances of all meshes
-/// may add up to: as many positions as the largest file the readers accept
-/// ([`super::MAX_FILE_BYTES`]) holds at 12 bytes each. Without instancing
-/// no file reaches it; the cap stops a small file that places a large mesh
-/// under thousands of nodes from asking for terabytes.
-pub const MAX_INSTANCED: u64 = super::MAX_FILE_BYTES / 12;
 
 /// Extensions a file may require that this reader honours: quantized
 /// attributes are read through the generic component decoding, and unlit
@@ -98,23 +113,23 @@ const SUPPORTED_REQUIRED: &[&str] = &["KHR_mesh_quantization", "KHR_materials_un
 /// are held in memory, nothing is allocated beyond what the checked counts
 /// and the buffers bound.
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<RawMesh> {
+    parse_gltf_with(bytes, path, super::DEFAULT_MAX_TRIANGLES)
+}
+
+/// [`parse_gltf`] with the most triangles all instances may add up to
+/// (three times as many vertices); see
+/// [`super::LoadOptions::max_triangles`].
+///
+/// # Errors
+/// As [`parse_gltf`]; [`Error::Parse`] naming the primitive whose instance
+/// passes the limit.
+pub fn parse_gltf_with(bytes: &[u8], path: &Path, max_triangles: u64) -> Result<RawMesh> {
     let (text, bin) = if bytes.starts_with(b"glTF") {
         split_glb(bytes, path)?
     } else {
         (bytes, None)
     };
-    let root: json::Root = json::deserialize::from_slice(text).map_err(|e| Error::Parse {
-        file: path.to_owned(),
-        place: Place::line(e.line() as u64),
-        message: format!(
-            "{}not a glTF document: {e}",
-            if bytes.starts_with(b"glTF") {
-                "JSON chunk: "
-            } else {
-                ""
-            }
-        ),
-    })?;
+    let root = parse_document(text, path, bytes.starts_with(b"glTF"))?;
     let mut reader = Reader {
         root: &root,
         path,
@@ -125,11 +140,304 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<RawMesh> {
         base_color: None,
         factors_used: false,
         instanced_triangles: 0,
+        max_triangles,
         notes: HashSet::new(),
     };
     reader.check_extensions()?;
     reader.read_scene()?;
     reader.finish()
+}
+
+/// The typed document of the JSON `text`, after the checks the typed model
+/// does not make: `asset`'s versions ([`check_asset`]), and integers of
+/// 2^32 and more where the schema wants an index or a code
+/// ([`check_integers`]), which the model would read modulo 2^32. An
+/// `extras` member may hold any JSON value, but the model only takes an
+/// object: when the text does not deserialize, it is tried again without
+/// any `extras` ([`drop_extras`]).
+///
+/// # Errors
+/// [`Error::Parse`]: not JSON, or not a glTF document, with the line where
+/// serde_json gives one (the JSON chunk's line for a `.glb`); the object
+/// and field at fault for the checks.
+///
+/// Cost: O(text) time: the text is parsed twice (as a `serde_json::Value`,
+/// then typed), three times when the typed parse fails; one of these
+/// copies is held at a time.
+fn parse_document(text: &[u8], path: &Path, is_glb: bool) -> Result<json::Root> {
+    let fail = |place: Place, message: String| Error::Parse {
+        file: path.to_owned(),
+        place,
+        message,
+    };
+    let not_gltf = |e: &serde_json::Error| {
+        fail(
+            match e.line() {
+                0 => Place::default(),
+                line => Place::line(line as u64),
+            },
+            format!(
+                "{}not a glTF document: {e}",
+                if is_glb { "JSON chunk: " } else { "" }
+            ),
+        )
+    };
+    let value: Value = serde_json::from_slice(text).map_err(|e| not_gltf(&e))?;
+    check_asset(&value).map_err(|m| fail(place_of(&[Step::Key("asset")]), m))?;
+    let mut steps = Vec::new();
+    check_integers(&value, None, &mut steps).map_err(|m| fail(place_of(&steps), m))?;
+    // Not held while the typed model is: a document is read twice, but
+    // held once at a time.
+    drop(value);
+    let typed = match json::deserialize::from_slice(text) {
+        Ok(root) => return Ok(root),
+        Err(typed) => typed,
+    };
+    let mut value: Value = serde_json::from_slice(text).map_err(|e| not_gltf(&e))?;
+    if !drop_extras(&mut value) {
+        return Err(not_gltf(&typed));
+    }
+    json::deserialize::from_value(value).map_err(|e| {
+        // The same complaint as the text's: the text's line is its place.
+        let bare = e.to_string();
+        let located = typed.to_string();
+        if located.strip_suffix(&format!(
+            " at line {} column {}",
+            typed.line(),
+            typed.column()
+        )) == Some(bare.as_str())
+        {
+            not_gltf(&typed)
+        } else {
+            fail(
+                Place::default(),
+                format!(
+                    "{}not a glTF document (its extras set aside): {bare}",
+                    if is_glb { "JSON chunk: " } else { "" }
+                ),
+            )
+        }
+    })
+}
+
+/// Refuses an `asset.version` whose major version is not 2, and an
+/// `asset.minVersion` above 2.0 (glTF 2.0, "Asset": a loader must refuse a
+/// major version it does not know, and a minimum version it does not
+/// support). A missing or mistyped field is left to the typed model.
+fn check_asset(document: &Value) -> std::result::Result<(), String> {
+    let Some(asset) = document.get("asset") else {
+        return Ok(());
+    };
+    if let Some(Value::String(version)) = asset.get("version") {
+        match major_minor(version) {
+            Some((2, _)) => {}
+            Some((major, _)) => {
+                return Err(format!(
+                    "version \"{version}\": glTF {major}.x is not read, only 2.x"
+                ))
+            }
+            None => return Err(format!("version \"{version}\" is not MAJOR.MINOR")),
+        }
+    }
+    if let Some(Value::String(version)) = asset.get("minVersion") {
+        match major_minor(version) {
+            Some(v) if v <= (2, 0) => {}
+            Some(_) => {
+                return Err(format!(
+                    "minVersion \"{version}\": the asset needs a reader of glTF {version}, this \
+                     one reads 2.0"
+                ))
+            }
+            None => return Err(format!("minVersion \"{version}\" is not MAJOR.MINOR")),
+        }
+    }
+    Ok(())
+}
+
+/// `"2.1"` as `(2, 1)`: the specification's pattern `[0-9]+\.[0-9]+`.
+fn major_minor(version: &str) -> Option<(u64, u64)> {
+    let (major, minor) = version.split_once('.')?;
+    let number = |s: &str| {
+        if s.is_empty() || !s.bytes().all(|b| b.is_ascii_digit()) {
+            return None;
+        }
+        s.parse().ok()
+    };
+    Some((number(major)?, number(minor)?))
+}
+
+/// A step of a JSON path: an object member or an array item.
+#[derive(Clone, Copy)]
+enum Step<'a> {
+    Key(&'a str),
+    Item(usize),
+}
+
+/// Fields whose integers are indices of glTF objects (glTF 2.0 JSON
+/// schema): those of every core object, found by their names. `attributes`
+/// and `targets` hold maps of indices by semantic.
+const INDEX_FIELDS: &[&str] = &[
+    "attributes",
+    "buffer",
+    "bufferView",
+    "camera",
+    "children",
+    "index",
+    "indices",
+    "input",
+    "inverseBindMatrices",
+    "joints",
+    "material",
+    "mesh",
+    "node",
+    "nodes",
+    "output",
+    "sampler",
+    "scene",
+    "skeleton",
+    "skin",
+    "source",
+    "targets",
+];
+
+/// Fields whose integers are codes or small numbers the typed model holds
+/// in 32 bits (component types, modes, targets, filters, wrapping modes,
+/// texture coordinate sets). The other integer fields, `byteOffset`,
+/// `byteLength`, `byteStride` and `count`, are read in 64 bits and checked
+/// against the data.
+const CODE_FIELDS: &[&str] = &[
+    "componentType",
+    "magFilter",
+    "minFilter",
+    "mode",
+    "target",
+    "texCoord",
+    "wrapS",
+    "wrapT",
+];
+
+/// Refuses an integer of 2^32 or more in an index or code field (named
+/// `field`, the member that holds it, or the map of semantics it is in),
+/// outside `extras` and `extensions`; `steps` is `value`'s path, and on
+/// error the path of the integer.
+///
+/// Cost: O(value) time; recursion as deep as the JSON's nesting, which
+/// serde_json bounds (128).
+fn check_integers<'v>(
+    value: &'v Value,
+    field: Option<&'v str>,
+    steps: &mut Vec<Step<'v>>,
+) -> std::result::Result<(), String> {
+    match value {
+        Value::Number(n) => {
+            let (Some(field), Some(x)) = (field, n.as_u64()) else {
+                return Ok(());
+            };
+            if x <= u64::from(u32::MAX) {
+                return Ok(());
+            }
+            let what = if INDEX_FIELDS.contains(&field) {
+                "an index"
+            } else if CODE_FIELDS.contains(&field) {
+                "a valid value (at most 2^32 - 1)"
+            } else {
+                return Ok(());
+            };
+            let inner = steps.iter().skip(usize::from(is_top_object(steps)) * 2);
+            let mut name = String::new();
+            for step in inner {
+                match step {
+                    Step::Key(k) if name.is_empty() => name.push_str(k),
+                    Step::Key(k) => {
+                        name.push('.');
+                        name.push_str(k);
+                    }
+                    Step::Item(i) => name.push_str(&format!("[{i}]")),
+                }
+            }
+            if name.is_empty() {
+                name.push_str("value");
+            }
+            Err(format!("{name} {x} is not {what}"))
+        }
+        Value::Array(items) => {
+            for (i, item) in items.iter().enumerate() {
+                steps.push(Step::Item(i));
+                check_integers(item, field, steps)?;
+                steps.pop();
+            }
+            Ok(())
+        }
+        Value::Object(members) => {
+            let semantics = matches!(field, Some("attributes" | "targets"));
+            for (key, member) in members {
+                if key == "extras" || key == "extensions" {
+                    continue;
+                }
+                steps.push(Step::Key(key));
+                check_integers(member, if semantics { field } else { Some(key) }, steps)?;
+                steps.pop();
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Whether `steps` starts at an object of one of the root's arrays
+/// (`nodes[3]`).
+fn is_top_object(steps: &[Step]) -> bool {
+    matches!(steps, [Step::Key(_), Step::Item(_), ..])
+}
+
+/// The place of the JSON path `steps`: the object of a root array it lies
+/// in (`node 3`, from `nodes[3]`), else the root member (`asset`).
+fn place_of(steps: &[Step]) -> Place {
+    match steps {
+        [Step::Key(array), Step::Item(i), ..] => {
+            let element = match *array {
+                "accessors" => "accessor",
+                "animations" => "animation",
+                "buffers" => "buffer",
+                "bufferViews" => "bufferView",
+                "cameras" => "camera",
+                "images" => "image",
+                "materials" => "material",
+                "meshes" => "mesh",
+                "nodes" => "node",
+                "samplers" => "sampler",
+                "scenes" => "scene",
+                "skins" => "skin",
+                "textures" => "texture",
+                other => other,
+            };
+            Place::element(element, *i as u64)
+        }
+        [Step::Key("asset"), ..] => Place {
+            element: Some("asset".into()),
+            ..Place::default()
+        },
+        _ => Place {
+            element: Some("root".into()),
+            ..Place::default()
+        },
+    }
+}
+
+/// Removes every `extras` member; whether there was one.
+///
+/// Cost: O(value) time; recursion bounded as in [`check_integers`].
+fn drop_extras(value: &mut Value) -> bool {
+    match value {
+        Value::Array(items) => items.iter_mut().fold(false, |d, v| drop_extras(v) | d),
+        Value::Object(members) => {
+            let dropped = members.remove("extras").is_some();
+            members
+                .values_mut()
+                .fold(dropped, |d, v| drop_extras(v) | d)
+        }
+        _ => false,
+    }
 }
 
 /// The GLB BIN chunk: its bytes and their offset in the file.
@@ -247,16 +555,39 @@ struct Buffer<'a> {
     origin: String,
 }
 
-/// An accessor's elements, checked against its buffer.
+/// Where elements lie in a buffer: element `k` at byte
+/// `start + k * stride` of buffer `buffer` (read), all checked to lie
+/// inside their buffer view.
+#[derive(Clone, Copy)]
+struct Run {
+    buffer: usize,
+    start: usize,
+    stride: usize,
+}
+
+/// An accessor's elements, checked against their buffers: base values,
+/// then a sparse accessor's substitutions.
 struct Elements {
     ty: ComponentType,
     normalized: bool,
     dims: usize,
     count: usize,
-    /// Byte of element 0 in the buffer.
-    start: usize,
-    stride: usize,
-    buffer: usize,
+    /// The base values; `None` for an accessor without bufferView, whose
+    /// base values are zeros (its count checked against the caller's
+    /// limit, as no bytes bound it).
+    dense: Option<Run>,
+    sparse: Option<Sparse>,
+}
+
+/// A sparse accessor's substitutions (glTF 2.0, "Sparse Accessors"):
+/// `count` element indices of type `index_ty`, which must strictly
+/// increase and stay below the accessor's count, and as many elements of
+/// the accessor's type at `values`; both tightly packed.
+struct Sparse {
+    count: usize,
+    index_ty: ComponentType,
+    indices: Run,
+    values: Run,
 }
 
 /// The base-colour texture chosen, and the image it came from.
@@ -278,6 +609,9 @@ struct Reader<'a> {
     /// Whether some material's base-colour factor is not white.
     factors_used: bool,
     instanced_triangles: u64,
+    /// The caller's limit on `instanced_triangles` (and on three times as
+    /// many vertices).
+    max_triangles: u64,
     /// Notes printed so far (each once, though a mesh is instanced often).
     notes: HashSet<String>,
 }
@@ -293,7 +627,13 @@ impl<'a> Reader<'a> {
 
     fn note(&mut self, message: String) {
         if self.notes.insert(message.clone()) {
-            eprintln!("note: {}: {message}", self.path.display());
+            // A closed or full standard error is no reason to fail a load.
+            use std::io::Write as _;
+            let _ = writeln!(
+                std::io::stderr(),
+                "note: {}: {message}",
+                self.path.display()
+            );
         }
     }
 
@@ -474,12 +814,15 @@ impl<'a> Reader<'a> {
         let positions = self.elements(pa, &[3], "POSITION", &place)?;
         let count = positions.count;
         let before = self.raw.positions.len();
-        if before as u64 + count as u64 > MAX_INSTANCED {
+        let max_vertices = self.max_triangles.saturating_mul(3);
+        if before as u64 + count as u64 > max_vertices {
             return Err(self.fail(
                 place,
                 format!(
-                    "the scene's instances hold more than {MAX_INSTANCED} vertices, the most \
-                     this reader builds"
+                    "the scene's instances ask for more than {max_vertices} vertices, three \
+                     times the limit of {} triangles{}",
+                    self.max_triangles,
+                    super::RAISE_LIMIT
                 ),
             ));
         }
@@ -512,12 +855,13 @@ impl<'a> Reader<'a> {
         };
         let triangles = self.triangles(mode, &indices, &place)?;
         self.instanced_triangles += triangles.len() as u64;
-        if self.instanced_triangles > MAX_INSTANCED {
+        if self.instanced_triangles > self.max_triangles {
             return Err(self.fail(
                 place,
                 format!(
-                    "the scene's instances hold more than {MAX_INSTANCED} triangles, the most \
-                     this reader builds"
+                    "the scene's instances ask for more than {} triangles, the limit{}",
+                    self.max_triangles,
+                    super::RAISE_LIMIT
                 ),
             ));
         }
@@ -844,8 +1188,10 @@ impl<'a> Reader<'a> {
         }
     }
 
-    /// Accessor `a`'s layout, checked: a type of `dims` components, a
-    /// buffer view, and every element inside the view.
+    /// Accessor `a`'s layout, checked: a type of `dims` components; base
+    /// values in a buffer view (every element inside it) or zeros, at most
+    /// three times the caller's triangle limit; sparse indices and values
+    /// inside their views.
     fn elements(
         &mut self,
         a: usize,
@@ -892,33 +1238,113 @@ impl<'a> Reader<'a> {
                 format!("type {shape:?} where {what} needs {}", want.join(" or ")),
             ));
         }
-        if accessor.sparse.is_some() {
-            return Err(self.fail(
-                aplace,
-                "sparse accessors are not supported (only dense attributes and indices are read)"
-                    .into(),
-            ));
-        }
-        let Some(view) = accessor.buffer_view else {
-            return Err(self.fail(
-                aplace,
-                "no bufferView: an all-zero accessor is not read".into(),
-            ));
-        };
-        let v = view.value();
-        let (buffer, range) = self.view_range(v, &aplace)?;
         let size = ty.size() * n;
-        let stride = root.buffer_views[v].byte_stride.map_or(size, |s| s.0);
+        let count = accessor.count.0;
+        let dense = match accessor.buffer_view {
+            Some(v) => {
+                let offset = accessor.byte_offset.map_or(0, |o| o.0);
+                Some(self.run(a, "", v.value(), offset, count, size, true)?)
+            }
+            None => {
+                let most = self.max_triangles.saturating_mul(3);
+                if count > most || count.checked_mul(size as u64).is_none() {
+                    return Err(self.fail(
+                        aplace,
+                        format!(
+                            "no bufferView: {count} elements of zeros, more than the {most} \
+                             vertices allowed by the limit of {} triangles{}",
+                            self.max_triangles,
+                            super::RAISE_LIMIT
+                        ),
+                    ));
+                }
+                None
+            }
+        };
+        let sparse = match &accessor.sparse {
+            None => None,
+            Some(s) => {
+                let k = s.count.0;
+                if k > count {
+                    return Err(self.fail(
+                        aplace,
+                        format!("sparse.count is {k}, more than the accessor's count {count}"),
+                    ));
+                }
+                let Checked::Valid(index_ty) = s.indices.component_type else {
+                    return Err(self.fail(
+                        aplace,
+                        "sparse.indices.componentType is not an unsigned byte, short or int".into(),
+                    ));
+                };
+                let index_ty = index_ty.0;
+                let (iv, vv) = (s.indices.buffer_view.value(), s.values.buffer_view.value());
+                let indices = self.run(
+                    a,
+                    "sparse.indices: ",
+                    iv,
+                    s.indices.byte_offset.0,
+                    k,
+                    index_ty.size(),
+                    false,
+                )?;
+                let values = self.run(
+                    a,
+                    "sparse.values: ",
+                    vv,
+                    s.values.byte_offset.0,
+                    k,
+                    size,
+                    false,
+                )?;
+                Some(Sparse {
+                    count: k as usize,
+                    index_ty,
+                    indices,
+                    values,
+                })
+            }
+        };
+        Ok(Elements {
+            ty,
+            normalized: accessor.normalized,
+            dims: n,
+            count: count as usize,
+            dense,
+            sparse,
+        })
+    }
+
+    /// `count` elements of `size` bytes from byte `offset` of buffer view
+    /// `v`, for accessor `a` (`what` prefixes messages): every `size` bytes,
+    /// or every byteStride of the view when `strided`; checked to end
+    /// inside the view, the view inside its buffer, before any is read.
+    #[allow(clippy::too_many_arguments)]
+    fn run(
+        &mut self,
+        a: usize,
+        what: &str,
+        v: usize,
+        offset: u64,
+        count: u64,
+        size: usize,
+        strided: bool,
+    ) -> Result<Run> {
+        let aplace = Place::element("accessor", a as u64);
+        let (buffer, range) = self.view_range(v, &aplace)?;
+        let stride = match self.root.buffer_views[v].byte_stride {
+            Some(s) if strided => s.0,
+            _ => size,
+        };
         if stride < size {
             return Err(self.fail(
                 aplace,
                 format!(
-                    "buffer view {v}'s byteStride {stride} is less than an element ({size} bytes)"
+                    "{what}buffer view {v}'s byteStride {stride} is less than an element \
+                     ({size} bytes)"
                 ),
             ));
         }
-        let offset = accessor.byte_offset.map_or(0, |o| o.0);
-        let count = accessor.count.0;
         // The last element ends at offset + stride * (count - 1) + size.
         let end = match count {
             0 => Some(offset),
@@ -928,29 +1354,20 @@ impl<'a> Reader<'a> {
                 .and_then(|x| x.checked_add(size as u64)),
         };
         let view_length = (range.end - range.start) as u64;
-        let start = range.start as u64 + offset;
+        let start = (range.start as u64).saturating_add(offset);
         match end {
-            Some(end) if end <= view_length => Ok(Elements {
-                ty,
-                normalized: accessor.normalized,
-                dims: n,
-                count: count as usize,
+            Some(end) if end <= view_length => Ok(Run {
+                buffer,
                 start: start as usize,
                 stride,
-                buffer,
             }),
             _ => {
-                let b = &self.buffers[buffer];
-                let base = b.as_ref().and_then(|b| b.base);
-                let origin = b.as_ref().map(|b| b.origin.clone()).unwrap_or_default();
+                let origin = &self.loaded(buffer).origin;
                 Err(self.fail(
-                    Place {
-                        byte: base.map(|base| base + start),
-                        ..aplace
-                    },
+                    self.byte_place(a, buffer, start),
                     format!(
-                        "{count} elements of {size} bytes every {stride} from byte {start} of \
-                         buffer {buffer} ({origin}) run past the end of buffer view {v} \
+                        "{what}{count} elements of {size} bytes every {stride} from byte {start} \
+                         of buffer {buffer} ({origin}) run past the end of buffer view {v} \
                          ({view_length} bytes from byte {})",
                         range.start
                     ),
@@ -959,46 +1376,112 @@ impl<'a> Reader<'a> {
         }
     }
 
-    /// The place of byte `at` of accessor `a`'s buffer.
-    fn byte_place(&self, a: usize, e: &Elements, at: usize) -> Place {
-        let base = self.buffers[e.buffer].as_ref().and_then(|b| b.base);
+    /// Buffer `b`, read.
+    fn loaded(&self, b: usize) -> &Buffer<'a> {
+        let Some(buffer) = self.buffers[b].as_ref() else {
+            unreachable!("run() reads the buffer of every element it returns");
+        };
+        buffer
+    }
+
+    /// The place of byte `at` of buffer `b`, for accessor `a`.
+    fn byte_place(&self, a: usize, b: usize, at: u64) -> Place {
+        let base = self.buffers[b].as_ref().and_then(|b| b.base);
         Place {
-            byte: base.map(|base| base + at as u64),
+            byte: base.map(|base| base.saturating_add(at)),
             ..Place::element("accessor", a as u64)
         }
     }
 
     /// The elements' components as `f32` (integers normalised when the
-    /// accessor says so), `dims` per element; all finite.
+    /// accessor says so), `dims` per element, sparse substitutions made;
+    /// all finite.
     fn floats(&self, a: usize, e: &Elements) -> Result<Vec<f32>> {
-        let Some(buffer) = self.buffers[e.buffer].as_ref() else {
-            unreachable!("elements() reads the buffer");
-        };
-        let bytes = &buffer.bytes[..];
         let size = e.ty.size();
-        let mut out = Vec::with_capacity(e.count * e.dims);
-        for k in 0..e.count {
-            let at = e.start + k * e.stride;
-            for j in 0..e.dims {
-                let x = component(&bytes[at + j * size..], e.ty, e.normalized);
-                if !x.is_finite() {
-                    return Err(self.fail(
-                        self.byte_place(a, e, at + j * size),
-                        format!(
-                            "component {j} of element {k} is {x} (byte {} of buffer {}, {})",
-                            at + j * size,
-                            e.buffer,
-                            buffer.origin
-                        ),
-                    ));
+        // Component `j` at byte `at`, checked finite; `which` names it.
+        let read = |run: &Run, buffer: &Buffer, at: usize, which: &dyn Fn() -> String| {
+            let x = component(&buffer.bytes[at..], e.ty, e.normalized);
+            if x.is_finite() {
+                return Ok(x);
+            }
+            Err(self.fail(
+                self.byte_place(a, run.buffer, at as u64),
+                format!(
+                    "{} is {x} (byte {at} of buffer {}, {})",
+                    which(),
+                    run.buffer,
+                    buffer.origin
+                ),
+            ))
+        };
+        let mut out = match &e.dense {
+            None => vec![0.0; e.count * e.dims],
+            Some(run) => {
+                let buffer = self.loaded(run.buffer);
+                let mut out = Vec::with_capacity(e.count * e.dims);
+                for k in 0..e.count {
+                    let at = run.start + k * run.stride;
+                    for j in 0..e.dims {
+                        out.push(read(run, buffer, at + j * size, &|| {
+                            format!("component {j} of element {k}")
+                        })?);
+                    }
                 }
-                out.push(x);
+                out
+            }
+        };
+        if let Some(s) = &e.sparse {
+            let buffer = self.loaded(s.values.buffer);
+            let mut previous = None;
+            for k in 0..s.count {
+                let i = self.sparse_index(a, e, s, k, &mut previous)?;
+                let at = s.values.start + k * s.values.stride;
+                for j in 0..e.dims {
+                    out[i * e.dims + j] = read(&s.values, buffer, at + j * size, &|| {
+                        format!("component {j} of sparse value {k} (element {i})")
+                    })?;
+                }
             }
         }
         Ok(out)
     }
 
-    /// Index accessor `a`'s values, each below `vertex_count`.
+    /// Sparse index `k` of accessor `a`: the element it replaces, checked
+    /// to be below the accessor's count and above `previous`, the one
+    /// before (then set to it).
+    fn sparse_index(
+        &self,
+        a: usize,
+        e: &Elements,
+        s: &Sparse,
+        k: usize,
+        previous: &mut Option<usize>,
+    ) -> Result<usize> {
+        let buffer = self.loaded(s.indices.buffer);
+        let at = s.indices.start + k * s.indices.stride;
+        let i = unsigned(&buffer.bytes[at..], s.index_ty) as usize;
+        let problem = match *previous {
+            _ if i >= e.count => format!("the accessor has {} elements", e.count),
+            Some(p) if i <= p => format!(
+                "not above sparse index {} ({p}): sparse indices strictly increase",
+                k - 1
+            ),
+            _ => {
+                *previous = Some(i);
+                return Ok(i);
+            }
+        };
+        Err(self.fail(
+            self.byte_place(a, s.indices.buffer, at as u64),
+            format!(
+                "sparse index {k} is {i}, {problem} (byte {at} of buffer {}, {})",
+                s.indices.buffer, buffer.origin
+            ),
+        ))
+    }
+
+    /// Index accessor `a`'s values, sparse substitutions made, each below
+    /// `vertex_count`.
     fn indices(&mut self, a: usize, vertex_count: usize, place: &Place) -> Result<Vec<u32>> {
         let e = self.elements(a, &[1], "indices", place)?;
         if !matches!(
@@ -1013,29 +1496,51 @@ impl<'a> Reader<'a> {
                 ),
             ));
         }
-        let Some(buffer) = self.buffers[e.buffer].as_ref() else {
-            unreachable!("elements() reads the buffer");
-        };
-        let bytes = &buffer.bytes[..];
-        let mut out = Vec::with_capacity(e.count);
-        for k in 0..e.count {
-            let at = e.start + k * e.stride;
-            let i = match e.ty {
-                ComponentType::U8 => u32::from(bytes[at]),
-                ComponentType::U16 => u32::from(u16::from_le_bytes([bytes[at], bytes[at + 1]])),
-                _ => u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]),
-            };
-            if i as usize >= vertex_count {
-                return Err(self.fail(
-                    self.byte_place(a, &e, at),
-                    format!(
-                        "index {k} is {i}, the primitive has {vertex_count} vertices (byte {at} \
-                         of buffer {}, {})",
-                        e.buffer, buffer.origin
-                    ),
-                ));
+        // The index at byte `at` of `run`'s buffer, checked; `which` names it.
+        let read = |run: &Run, buffer: &Buffer, at: usize, which: &dyn Fn() -> String| {
+            let i = unsigned(&buffer.bytes[at..], e.ty);
+            if (i as usize) < vertex_count {
+                return Ok(i);
             }
-            out.push(i);
+            Err(self.fail(
+                self.byte_place(a, run.buffer, at as u64),
+                format!(
+                    "{} is {i}, the primitive has {vertex_count} vertices (byte {at} of buffer \
+                     {}, {})",
+                    which(),
+                    run.buffer,
+                    buffer.origin
+                ),
+            ))
+        };
+        let mut out = match &e.dense {
+            None if e.count > 0 && vertex_count == 0 => {
+                return Err(self.fail(
+                    Place::element("accessor", a as u64),
+                    "no bufferView: the indices are 0, the primitive has no vertices".into(),
+                ))
+            }
+            None => vec![0; e.count],
+            Some(run) => {
+                let buffer = self.loaded(run.buffer);
+                let mut out = Vec::with_capacity(e.count);
+                for k in 0..e.count {
+                    let at = run.start + k * run.stride;
+                    out.push(read(run, buffer, at, &|| format!("index {k}"))?);
+                }
+                out
+            }
+        };
+        if let Some(s) = &e.sparse {
+            let buffer = self.loaded(s.values.buffer);
+            let mut previous = None;
+            for k in 0..s.count {
+                let i = self.sparse_index(a, &e, s, k, &mut previous)?;
+                let at = s.values.start + k * s.values.stride;
+                out[i] = read(&s.values, buffer, at, &|| {
+                    format!("sparse value {k} (index {i})")
+                })?;
+            }
         }
         Ok(out)
     }
@@ -1098,6 +1603,16 @@ fn component(bytes: &[u8], ty: ComponentType, normalized: bool) -> f32 {
             }
         }
         ComponentType::U32 => u32::from_le_bytes([b(0), b(1), b(2), b(3)]) as f32,
+    }
+}
+
+/// An unsigned integer component at the start of `bytes` (which holds at
+/// least its size): `ty` is `U8`, `U16` or `U32`.
+fn unsigned(bytes: &[u8], ty: ComponentType) -> u32 {
+    match ty {
+        ComponentType::U8 => u32::from(bytes[0]),
+        ComponentType::U16 => u32::from(u16::from_le_bytes([bytes[0], bytes[1]])),
+        _ => u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]),
     }
 }
 

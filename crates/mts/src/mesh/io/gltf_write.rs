@@ -169,10 +169,6 @@ pub fn save_gltf(mesh: &Mesh, path: &Path) -> Result<()> {
     root["bufferViews"] = Value::Array(std::mem::take(&mut out.views));
     root["accessors"] = Value::Array(std::mem::take(&mut out.accessors));
 
-    let io = |file: &Path| {
-        let file = file.to_owned();
-        move |source| Error::Io { file, source }
-    };
     if binary {
         let mut text = serde_json::to_vec(&root).expect("a JSON value serialises");
         text.resize(text.len().next_multiple_of(4), b' ');
@@ -194,11 +190,11 @@ pub fn save_gltf(mesh: &Mesh, path: &Path) -> Result<()> {
             file.extend_from_slice(kind);
             file.extend_from_slice(data);
         }
-        std::fs::write(path, file).map_err(io(path))
+        crate::output::write_file(path, &file)
     } else {
         let text = serde_json::to_vec_pretty(&root).expect("a JSON value serialises");
-        std::fs::write(&bin_path, &out.bin).map_err(io(&bin_path))?;
-        std::fs::write(path, text).map_err(io(path))
+        crate::output::write_file(&bin_path, &out.bin)?;
+        crate::output::write_file(path, &text)
     }
 }
 

@@ -16,7 +16,7 @@ mod obj;
 mod ply;
 
 #[cfg(feature = "gltf")]
-pub use gltf::{parse_gltf, MAX_INSTANCED};
+pub use gltf::{parse_gltf, parse_gltf_with};
 #[cfg(feature = "gltf")]
 pub use gltf_write::save_gltf;
 pub use obj::{parse_obj, parse_obj_with};
@@ -128,8 +128,18 @@ impl Format {
     }
 }
 
+/// The most triangles [`LoadOptions::default`] lets a file ask for:
+/// 2^24 = 16,777,216. Building the model of that many takes about 10 GB
+/// (650 bytes a triangle at the peak, measured on the 1M icosphere), which
+/// is what a workstation has; a larger scan loads with a larger limit.
+pub const DEFAULT_MAX_TRIANGLES: u64 = 1 << 24;
+
+/// How a limit error tells the user what to do.
+pub(crate) const RAISE_LIMIT: &str =
+    " this load allows (LoadOptions::max_triangles; `mts --max-triangles N` raises it)";
+
 /// How [`load`] reads and cleans a file.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LoadOptions {
     /// Cleaning options (weld of identical positions).
     pub clean: CleanOptions,
@@ -137,6 +147,23 @@ pub struct LoadOptions {
     /// ([`crate::mesh::Properties`]); positions only otherwise (an OBJ's
     /// vertices are then not split at seams).
     pub properties: bool,
+    /// The most triangles the file may ask for (polygons triangulated,
+    /// strips decoded, glTF instances counted each time), and three times
+    /// as many vertices; more is an [`Error::Parse`] saying so. It bounds
+    /// the work and memory a small file can ask for: glTF instancing
+    /// multiplies a mesh by its nodes, and a one-byte strip index is a
+    /// triangle. Default [`DEFAULT_MAX_TRIANGLES`].
+    pub max_triangles: u64,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            clean: CleanOptions::default(),
+            properties: false,
+            max_triangles: DEFAULT_MAX_TRIANGLES,
+        }
+    }
 }
 
 /// Reads a whole file into memory, refusing files over [`MAX_FILE_BYTES`]
@@ -158,13 +185,22 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>> {
         place: crate::Place::default(),
         message,
     };
+    let not_a_file = || {
+        refuse(
+            "not a regular file (a directory, device or pipe): inputs are read whole from files"
+                .into(),
+        )
+    };
+    // Checked before opening: opening a FIFO for reading blocks until a
+    // writer comes, which may be never. Checked again on the open file, for
+    // a path swapped in between.
+    if !std::fs::metadata(path).map_err(io)?.is_file() {
+        return Err(not_a_file());
+    }
     let file = std::fs::File::open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
     if !meta.is_file() {
-        return Err(refuse(
-            "not a regular file (a directory, device or pipe): inputs are read whole from files"
-                .into(),
-        ));
+        return Err(not_a_file());
     }
     let len = meta.len();
     if len > MAX_FILE_BYTES {
@@ -207,12 +243,38 @@ pub fn parse(bytes: &[u8], format: Format, path: &Path) -> Result<RawMesh> {
 ///
 /// Cost: O(file size) time, the file is held in memory while parsing.
 pub fn load(path: &Path, options: LoadOptions) -> Result<(Mesh, CleanReport)> {
-    let bytes = read_file(path)?;
-    let format = Format::detect(path, &bytes)?;
+    load_bytes(&read_file(path)?, path, options)
+}
+
+/// [`load`] of a file already read: `path` names it in errors, tells its
+/// format with the bytes and, for glTF and OBJ, is the folder external
+/// buffers and textures are read from.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_bytes(bytes: &[u8], path: &Path, options: LoadOptions) -> Result<(Mesh, CleanReport)> {
+    let format = Format::detect(path, bytes)?;
     let mut raw = match format {
-        Format::Obj => parse_obj_with(&bytes, path, options.properties)?,
-        _ => parse(&bytes, format, path)?,
+        Format::Obj => parse_obj_with(bytes, path, options.properties)?,
+        #[cfg(feature = "gltf")]
+        Format::Gltf => parse_gltf_with(bytes, path, options.max_triangles)?,
+        Format::Ply => parse_ply(bytes, path)?,
     };
+    // OBJ and PLY hold at most a triangle per byte or two of the file (a
+    // strip or polygon of one-byte indices), so the file's size bounds
+    // what was read; the limit bounds what the caller does next.
+    let (triangles, vertices) = (raw.triangles.len() as u64, raw.positions.len() as u64);
+    if triangles > options.max_triangles || vertices > options.max_triangles.saturating_mul(3) {
+        return Err(Error::Parse {
+            file: path.to_owned(),
+            place: crate::Place::default(),
+            message: format!(
+                "{triangles} triangles over {vertices} vertices, more than the limit of {} \
+                 triangles (and three times as many vertices){RAISE_LIMIT}",
+                options.max_triangles
+            ),
+        });
+    }
     if !options.properties {
         raw.properties = crate::mesh::Properties::default();
     }
@@ -258,13 +320,6 @@ pub fn save_mesh(mesh: &Mesh, path: &Path) -> Result<()> {
 pub fn save_obj(mesh: &Mesh, path: &Path) -> Result<()> {
     use std::fmt::Write as _;
     use std::io::Write;
-    let io = |file: &Path| {
-        let file = file.to_owned();
-        move |source| Error::Io {
-            file: file.clone(),
-            source,
-        }
-    };
     let props = &mesh.properties;
     let mut head = String::new();
     if let Some(texture) = &props.texture {
@@ -277,60 +332,57 @@ pub fn save_obj(mesh: &Mesh, path: &Path) -> Result<()> {
             crate::mesh::Texture::Embedded { mime, bytes } => {
                 let ext = if mime.contains("jpeg") { "jpg" } else { "png" };
                 let name = format!("{stem}.{ext}");
-                std::fs::write(folder.join(&name), bytes).map_err(io(&folder.join(&name)))?;
+                crate::output::write_file(&folder.join(&name), bytes)?;
                 name
             }
         };
         let mtl = format!("{stem}.mtl");
-        std::fs::write(
-            folder.join(&mtl),
-            format!("newmtl textured\nKd 1 1 1\nmap_Kd {image}\n"),
-        )
-        .map_err(io(&folder.join(&mtl)))?;
+        crate::output::write_file(
+            &folder.join(&mtl),
+            format!("newmtl textured\nKd 1 1 1\nmap_Kd {image}\n").as_bytes(),
+        )?;
         let _ = write!(head, "mtllib {mtl}\nusemtl textured\n");
     }
-    let file = std::fs::File::create(path).map_err(io(path))?;
-    let mut w = std::io::BufWriter::new(file);
-    w.write_all(head.as_bytes()).map_err(io(path))?;
-    let mut points_written = 0;
-    for (i, p) in mesh.positions.iter().enumerate() {
-        // Points are numbered in order of first use: a new one is next.
-        if props.position_id(i as u32) != points_written {
-            continue;
-        }
-        points_written += 1;
-        match &props.colors {
-            Some(c) => {
-                let c = c[i];
-                writeln!(w, "v {} {} {} {} {} {}", p.x, p.y, p.z, c.x, c.y, c.z)
+    crate::output::write_with(path, |w| {
+        w.write_all(head.as_bytes())?;
+        let mut points_written = 0;
+        for (i, p) in mesh.positions.iter().enumerate() {
+            // Points are numbered in order of first use: a new one is next.
+            if props.position_id(i as u32) != points_written {
+                continue;
             }
-            None => writeln!(w, "v {} {} {}", p.x, p.y, p.z),
+            points_written += 1;
+            match &props.colors {
+                Some(c) => {
+                    let c = c[i];
+                    writeln!(w, "v {} {} {} {} {} {}", p.x, p.y, p.z, c.x, c.y, c.z)
+                }
+                None => writeln!(w, "v {} {} {}", p.x, p.y, p.z),
+            }?;
         }
-        .map_err(io(path))?;
-    }
-    for t in props.uvs.iter().flatten() {
-        writeln!(w, "vt {} {}", t.x, t.y).map_err(io(path))?;
-    }
-    for n in props.normals.iter().flatten() {
-        writeln!(w, "vn {} {} {}", n.x, n.y, n.z).map_err(io(path))?;
-    }
-    let corner = |v: u32| {
-        let p = props.position_id(v) + 1;
-        let v = v + 1;
-        match (props.uvs.is_some(), props.normals.is_some()) {
-            (false, false) => format!("{p}"),
-            (true, false) => format!("{p}/{v}"),
-            (false, true) => format!("{p}//{v}"),
-            (true, true) => format!("{p}/{v}/{v}"),
+        for t in props.uvs.iter().flatten() {
+            writeln!(w, "vt {} {}", t.x, t.y)?;
         }
-    };
-    for t in &mesh.triangles {
-        if props.is_empty() {
-            writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)
-        } else {
-            writeln!(w, "f {} {} {}", corner(t[0]), corner(t[1]), corner(t[2]))
+        for n in props.normals.iter().flatten() {
+            writeln!(w, "vn {} {} {}", n.x, n.y, n.z)?;
         }
-        .map_err(io(path))?;
-    }
-    w.flush().map_err(io(path))
+        let corner = |v: u32| {
+            let p = props.position_id(v) + 1;
+            let v = v + 1;
+            match (props.uvs.is_some(), props.normals.is_some()) {
+                (false, false) => format!("{p}"),
+                (true, false) => format!("{p}/{v}"),
+                (false, true) => format!("{p}//{v}"),
+                (true, true) => format!("{p}/{v}/{v}"),
+            }
+        };
+        for t in &mesh.triangles {
+            if props.is_empty() {
+                writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)
+            } else {
+                writeln!(w, "f {} {} {}", corner(t[0]), corner(t[1]), corner(t[2]))
+            }?;
+        }
+        Ok(())
+    })
 }

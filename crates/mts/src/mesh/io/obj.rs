@@ -604,7 +604,15 @@ impl Reader<'_> {
         let first = self.materials_used.first()?;
         let folder = self.path.parent().unwrap_or(Path::new(""));
         let warn = |what: String| {
-            eprintln!("{}: {what}; drawn untextured", self.path.display());
+            // A closed or full standard error is no reason to fail a load.
+            {
+                use std::io::Write as _;
+                let _ = writeln!(
+                    std::io::stderr(),
+                    "{}: {what}; drawn untextured",
+                    self.path.display()
+                );
+            }
         };
         let mut found: Vec<(String, Option<String>)> = Vec::new();
         let mut read = 0;

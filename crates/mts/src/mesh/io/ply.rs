@@ -1020,37 +1020,34 @@ pub fn save_ply(mesh: &Mesh, path: &Path) -> Result<()> {
         mesh.triangle_count()
     );
 
-    let io = |source| Error::Io {
-        file: path.to_owned(),
-        source,
-    };
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
-    w.write_all(header.as_bytes()).map_err(io)?;
-    let mut record: Vec<u8> = Vec::with_capacity(48);
-    for (v, p) in mesh.positions.iter().enumerate() {
-        record.clear();
-        put(&mut record, &p.to_array());
-        if let Some(normals) = &streams.normals {
-            put(&mut record, &normals[v].to_array());
+    crate::output::write_with(path, |w| {
+        w.write_all(header.as_bytes())?;
+        let mut record: Vec<u8> = Vec::with_capacity(48);
+        for (v, p) in mesh.positions.iter().enumerate() {
+            record.clear();
+            put(&mut record, &p.to_array());
+            if let Some(normals) = &streams.normals {
+                put(&mut record, &normals[v].to_array());
+            }
+            if let Some(uvs) = &streams.uvs {
+                put(&mut record, &uvs[v].to_array());
+            }
+            if let Some(colors) = &streams.colors {
+                let c = colors[v].to_array();
+                record.extend(c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8));
+            }
+            w.write_all(&record)?;
         }
-        if let Some(uvs) = &streams.uvs {
-            put(&mut record, &uvs[v].to_array());
+        for t in &mesh.triangles {
+            record.clear();
+            record.push(3);
+            for i in t {
+                record.extend_from_slice(&i.to_le_bytes());
+            }
+            w.write_all(&record)?;
         }
-        if let Some(colors) = &streams.colors {
-            let c = colors[v].to_array();
-            record.extend(c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8));
-        }
-        w.write_all(&record).map_err(io)?;
-    }
-    for t in &mesh.triangles {
-        record.clear();
-        record.push(3);
-        for i in t {
-            record.extend_from_slice(&i.to_le_bytes());
-        }
-        w.write_all(&record).map_err(io)?;
-    }
-    w.flush().map_err(io)
+        Ok(())
+    })
 }
 
 /// How a `comment TextureFile` line names `texture` for a PLY at `ply`.
