@@ -39,7 +39,7 @@ pub struct BenchRenderArgs {
     scene_with: Vec<std::path::PathBuf>,
     /// The scene's screen-space error allowed, in pixels.
     #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR,
-          allow_negative_numbers = true, value_parser = crate::pixel_error)]
+          allow_hyphen_values = true, value_parser = crate::pixel_error)]
     pixel_error: f32,
     /// Print JSON instead of a table.
     #[arg(long)]

@@ -59,9 +59,18 @@ impl<'m> DemoScene<'m> {
                 warnln!("{w}");
             }
             let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
-            let radius = ((mts::mesh::diagonal_of(min, max) * 0.5) as f32).max(f32::MIN_POSITIVE);
+            let radius = mts::mesh::diagonal_of(min, max) * 0.5;
             let centre = (min + max) * 0.5;
-            placed.push((id, 1.0 / radius, centre, min.y));
+            // Scaled to radius 1 where f32 can say it: a model of one
+            // point, or one whose scaled centre would overflow, is placed
+            // as it is.
+            let scale = (1.0 / radius) as f32;
+            let scale = if radius > 0.0 && (centre.abs().max_element() * scale).is_finite() {
+                scale
+            } else {
+                1.0
+            };
+            placed.push((id, scale, centre, min.y));
         }
         let side = (count as f64).sqrt().ceil() as usize;
         let mut instances = Vec::with_capacity(count);

@@ -509,13 +509,13 @@ struct SimplifyArgs {
     boundary_weight: Option<f64>,
     /// Weight of texture-coordinate distortion in the cost, with
     /// --properties (an error of 1/weight costs one bounding-box diagonal).
-    #[arg(long, value_name = "WEIGHT", allow_negative_numbers = true, value_parser = non_negative::<f32>)]
+    #[arg(long, value_name = "WEIGHT", allow_hyphen_values = true, value_parser = non_negative::<f32>)]
     uv_weight: Option<f32>,
     /// Weight of normal distortion in the cost, with --properties.
-    #[arg(long, value_name = "WEIGHT", allow_negative_numbers = true, value_parser = non_negative::<f32>)]
+    #[arg(long, value_name = "WEIGHT", allow_hyphen_values = true, value_parser = non_negative::<f32>)]
     normal_weight: Option<f32>,
     /// Weight of colour distortion in the cost, with --properties.
-    #[arg(long, value_name = "WEIGHT", allow_negative_numbers = true, value_parser = non_negative::<f32>)]
+    #[arg(long, value_name = "WEIGHT", allow_hyphen_values = true, value_parser = non_negative::<f32>)]
     color_weight: Option<f32>,
     /// Surface samples per side for the error measurement.
     #[arg(long, default_value_t = mts::distance::DEFAULT_SAMPLES, value_parser = count_in::<1, MAX_SAMPLES>, allow_negative_numbers = true)]

@@ -115,7 +115,7 @@ pub struct RenderArgs {
     /// With --scene: the screen-space error allowed, in pixels (0 draws
     /// every instance at full detail).
     #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR, requires = "scene",
-          allow_negative_numbers = true, value_parser = crate::pixel_error)]
+          allow_hyphen_values = true, value_parser = crate::pixel_error)]
     pixel_error: f32,
 }
 

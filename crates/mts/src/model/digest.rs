@@ -127,7 +127,8 @@ impl TriangleKey {
     /// ascending, without repeats.
     pub(crate) fn band_samples(&self, b: usize, first: u32, last: u32) -> Vec<u32> {
         let span = u64::from(last - first) + 1;
-        let drawn = first + (mix(self.k1 ^ (b as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)) % span) as u32;
+        let drawn =
+            first + (mix(self.k1 ^ (b as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)) % span) as u32;
         let mut lods = vec![first, drawn, last];
         lods.sort_unstable();
         lods.dedup();
@@ -164,7 +165,9 @@ pub(crate) fn replay_digests(
     let mut digest = Digest::default();
     for (t, tri) in triangles.iter().enumerate() {
         if tri.iter().any(|&v| v as usize >= vertices) {
-            return Err(format!("the recipe's triangle {t} names a vertex past {vertices}"));
+            return Err(format!(
+                "the recipe's triangle {t} names a vertex past {vertices}"
+            ));
         }
         for (c, &v) in tri.iter().enumerate() {
             let e = 3 * t + c;

@@ -475,8 +475,10 @@ impl MtsModel {
             })
         };
         let mut far_arcs = 0;
-        let mut digests: Vec<Vec<digest::Digest>> =
-            samples.iter().map(|l| vec![digest::Digest::default(); l.len()]).collect();
+        let mut digests: Vec<Vec<digest::Digest>> = samples
+            .iter()
+            .map(|l| vec![digest::Digest::default(); l.len()])
+            .collect();
         for r in results {
             let (far, chunk) = r?;
             far_arcs += far;
@@ -502,8 +504,10 @@ impl MtsModel {
         key: &digest::TriangleKey,
         samples: &[Vec<u32>],
     ) -> Result<(usize, Vec<Vec<digest::Digest>>), String> {
-        let mut digests: Vec<Vec<digest::Digest>> =
-            samples.iter().map(|l| vec![digest::Digest::default(); l.len()]).collect();
+        let mut digests: Vec<Vec<digest::Digest>> = samples
+            .iter()
+            .map(|l| vec![digest::Digest::default(); l.len()])
+            .collect();
         let max_lod = self.max_lod() as u32;
         let vertices = self.positions.len() as u32;
         let first_record = self.strip_records[strips.start];
@@ -554,7 +558,10 @@ impl MtsModel {
                     self.slot_size[s], w.len
                 ));
             }
-            let band = self.band_strips.partition_point(|&first| first as usize <= s) - 1;
+            let band = self
+                .band_strips
+                .partition_point(|&first| first as usize <= s)
+                - 1;
             for (&lod, d) in samples[band].iter().zip(&mut digests[band]) {
                 let len = if lod == birth {
                     w.len

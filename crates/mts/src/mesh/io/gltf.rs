@@ -1046,8 +1046,9 @@ impl<'a> Reader<'a> {
         }
         match &self.base_color {
             None => {
-                let texture = self.image(image, Place::element("texture", ti as u64))?;
-                self.base_color = Some(BaseColor { image, texture });
+                if let Some(texture) = self.image(image, Place::element("texture", ti as u64))? {
+                    self.base_color = Some(BaseColor { image, texture });
+                }
             }
             Some(chosen) if chosen.image != image => {
                 let first = chosen.image;
@@ -1061,8 +1062,10 @@ impl<'a> Reader<'a> {
         Ok(factor)
     }
 
-    /// Image `i` as a texture: a file beside the asset, or embedded bytes.
-    fn image(&mut self, i: usize, place: Place) -> Result<Texture> {
+    /// Image `i` as a texture: a file beside the asset, or embedded bytes;
+    /// `None`, with a note, for a file that cannot be read (the mesh is
+    /// drawn untextured, as an OBJ whose `map_Kd` is missing).
+    fn image(&mut self, i: usize, place: Place) -> Result<Option<Texture>> {
         let root = self.root;
         let Some(image) = root.images.get(i) else {
             return Err(self.fail(
@@ -1078,22 +1081,31 @@ impl<'a> Reader<'a> {
                 .as_ref()
                 .map(|b| b.bytes[range].to_vec())
                 .unwrap_or_default();
-            return Ok(Texture::Embedded {
+            return Ok(Some(Texture::Embedded {
                 mime: mime.unwrap_or_default(),
                 bytes,
-            });
+            }));
         }
         let Some(uri) = &image.uri else {
             return Err(self.fail(place, "neither a uri nor a bufferView".into()));
         };
         match data_uri(uri).map_err(|m| self.fail(place.clone(), m))? {
-            Some((data_mime, bytes)) => Ok(Texture::Embedded {
+            Some((data_mime, bytes)) => Ok(Some(Texture::Embedded {
                 mime: mime.unwrap_or(data_mime),
                 bytes,
-            }),
+            })),
             None => {
                 let relative = decode_uri(uri).map_err(|m| self.fail(place, m))?;
-                Ok(Texture::File(self.folder.join(relative)))
+                let file = self.folder.join(relative);
+                if std::fs::metadata(&file).is_ok_and(|m| m.is_file()) {
+                    Ok(Some(Texture::File(file)))
+                } else {
+                    self.note(format!(
+                        "image {i} ({}) is not a readable file: drawn untextured",
+                        file.display()
+                    ));
+                    Ok(None)
+                }
             }
         }
     }
@@ -1687,6 +1699,9 @@ fn not_base64(at: usize, c: char) -> String {
 /// URIs with a scheme (`http:`, `file:`): only files beside the asset and
 /// data URIs are read.
 pub(super) fn decode_uri(uri: &str) -> std::result::Result<PathBuf, String> {
+    if uri.is_empty() {
+        return Err("an empty URI names no file".into());
+    }
     if let Some((scheme, _)) = uri.split_once(':') {
         let is_scheme = scheme.len() > 1
             && scheme.starts_with(|c: char| c.is_ascii_alphabetic())

@@ -647,7 +647,14 @@ impl Reader<'_> {
                 "several materials with different textures; `{first}`'s ({map}) is used for all"
             ));
         }
-        Some(Texture::File(folder.join(map)))
+        // A texture that cannot be read is a warning here, not an error
+        // later in whatever uses it (a renderer, a .glb that embeds it).
+        let file = folder.join(map);
+        if !std::fs::metadata(&file).is_ok_and(|m| m.is_file()) {
+            warn(format!("texture {}: not a readable file", file.display()));
+            return None;
+        }
+        Some(Texture::File(file))
     }
 
     /// Texture-coordinate and normal indices against the counts in the
