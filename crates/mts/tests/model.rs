@@ -576,11 +576,10 @@ fn real_models_hold_the_invariant() {
 }
 
 /// Issue 31, item 8: a ready file whose records were changed and the file
-/// resealed (checksum recomputed) must not load and draw other triangles
-/// than its recipe. Every record's vertex plus one, and every entry of the
-/// LoD → triangle table plus one, is refused; a label changed is refused
-/// or draws the recipe's triangles at every band's first LoD (what loading
-/// checks; `model/digest.rs` says what is left to `mts verify`).
+/// resealed (checksum recomputed). Loading compares the strips with the
+/// recipe's replay at LoD 0 and at one LoD drawn per load
+/// (`model/digest.rs`): whatever loads draws the recipe's triangles at LoD
+/// 0, and every change to the LoD table at LoD 0 is refused.
 #[test]
 fn resealed_ready_models_that_lie_are_refused() {
     let good = small_file();
@@ -608,28 +607,31 @@ fn resealed_ready_models_that_lie_are_refused() {
     let codes = labels + lw * records;
     let table = codes + records + 8 * far;
     let model = MtsModel::from_bytes(&good, Path::new("good.mts")).unwrap();
-    let add_one = |at: usize| {
+    let add_one = |at: usize, width: usize| {
         let mut b = good.clone();
-        let v = u16::from_le_bytes([b[at], b[at + 1]]).wrapping_add(1);
-        b[at..at + 2].copy_from_slice(&v.to_le_bytes());
+        if width == 2 {
+            let v = u16::from_le_bytes([b[at], b[at + 1]]).wrapping_add(1);
+            b[at..at + 2].copy_from_slice(&v.to_le_bytes());
+        } else {
+            let v = u32::from_le_bytes(b[at..at + 4].try_into().unwrap()).wrapping_add(1);
+            b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+        }
         seal(&mut b);
         b
     };
     let mesh = model.mesh();
     let all: Vec<usize> = (0..=model.max_lod()).collect();
     // Each change: refused, harmless (the model still draws the recipe's
-    // triangles at every LoD: a field no walk reads), or a lie.
+    // triangles at every LoD: a field no walk reads), or a lie; whatever
+    // loads draws LoD 0 right.
     let judge = |bytes: &[u8]| match MtsModel::from_bytes(bytes, Path::new("bad.mts")) {
         Err(e) => {
             assert!(e.to_string().contains("MODL"), "{e}");
             0
         }
         Ok(m) => {
-            if mts::model::verify(&m, &mesh, &all).mismatches == 0 {
-                1
-            } else {
-                2
-            }
+            assert_eq!(mts::model::verify(&m, &mesh, &[0]).mismatches, 0);
+            usize::from(mts::model::verify(&m, &mesh, &all).mismatches != 0) + 1
         }
     };
     // Only records that start a node name a vertex (later arcs of a node
@@ -637,27 +639,23 @@ fn resealed_ready_models_that_lie_are_refused() {
     let mut vertex = [0; 3];
     for r in 0..records {
         if r == 0 || good[codes + r - 1] & 0x80 == 0 {
-            vertex[judge(&add_one(vertices + 2 * r))] += 1;
+            vertex[judge(&add_one(vertices + 2 * r, 2))] += 1;
         }
     }
     let mut label = [0; 3];
     for r in 0..records {
-        label[judge(&add_one(labels + 2 * r))] += 1;
+        label[judge(&add_one(labels + 2 * r, 2))] += 1;
     }
-    eprintln!("vertex changes refused/harmless/lies {vertex:?}, labels {label:?}");
+    let mut entries = [0; 3];
     for lod in 0..=model.max_lod() {
-        let b = {
-            let mut b = good.clone();
-            let at = table + 4 * lod;
-            let v = u32::from_le_bytes(b[at..at + 4].try_into().unwrap()).wrapping_add(1);
-            b[at..at + 4].copy_from_slice(&v.to_le_bytes());
-            seal(&mut b);
-            b
-        };
-        assert!(
-            MtsModel::from_bytes(&b, Path::new("table.mts")).is_err(),
-            "table entry {lod} plus one accepted"
-        );
+        entries[judge(&add_one(table + 4 * lod, 4))] += 1;
     }
-    assert!(vertex[0] > 300);
+    eprintln!(
+        "refused / harmless / lies: record vertices {vertex:?}, labels {label:?}, table {entries:?}"
+    );
+    // Band 0's nodes walked at LoD 0 (an eighth of this model's) are
+    // always checked, and table entry 0 is read when the file is parsed;
+    // the rest is caught when the drawn LoD falls where the lie shows.
+    assert!(vertex[0] * 10 > vertex.iter().sum::<usize>(), "{vertex:?}");
+    assert!(entries[0] >= 1, "{entries:?}");
 }

@@ -1,6 +1,6 @@
 //! What loading a ready `.mts` guarantees: its strips draw what its recipe
-//! replays at three LoDs of every band (the first, the last and one drawn
-//! at random), and its LoD → triangle table is the replay's at every LoD.
+//! replays at LoD 0 and at one LoD drawn at random per load, with the
+//! triangle counts its LoD table gives there.
 //!
 //! A version-3 file carries the model twice: the recipe (the LoD-0 strips
 //! and the contraction sequence, what the model is built from) and the
@@ -9,31 +9,32 @@
 //! ([`MtsModel::validate`]) keep such a file memory-safe, but it could draw
 //! other triangles than the recipe says (a record's vertex plus one).
 //!
-//! **Decision.** Loading compares the two at a sample of LoDs. Validation
-//! walks every strip at its band's first LoD anyway (to check its slot
-//! size); it also walks it at the band's last LoD and at one LoD of the
-//! band drawn at random, and sums each band's triangles at each of these
-//! into a multiset digest: the wrapping sum of a keyed 64-bit hash of each
-//! oriented triangle (canonical rotation). The recipe is replayed once,
-//! incrementally (per-vertex triangle lists; a contraction visits only the
-//! triangles around the vertices it moves), its digest taken at the same
-//! LoDs and its live triangles counted at every LoD. The key and the random
-//! LoDs are drawn per process, so a file cannot be made to collide, nor
-//! know which LoDs are looked at. Why these three: every node of a band's
-//! strips is walked at its first LoD except those a contraction inside the
-//! band brings in; most of those still stand at the band's last LoD (a band
-//! ends when a tenth of its triangles are gone), and the random one reaches
-//! the rest with the probability of its share of the band. Cost: the
-//! replay is O(triangles + the triangles each contraction moves), beside
-//! the strip checks on another thread; two more walks of every strip.
+//! **Decision: a sample, drawn per load.** Loading compares, at LoD 0 and
+//! at one LoD drawn at random, the multiset of triangles the strips draw
+//! with the recipe's replay there: each side is summed into a digest, the wrapping sum of a
+//! keyed 64-bit hash of each oriented triangle (canonical rotation), with
+//! its count, which must also be the LoD table's. The key and the LoDs are
+//! drawn per process, so a file can neither be made to collide nor know
+//! where it is looked at. The walks reuse validation's (every strip is
+//! walked at its band's first LoD to check its slot), plus one walk of the
+//! drawn LoD's band; the replay maps the recipe's triangles through their
+//! representatives there (climbs of the contraction forest with path
+//! compression) on a second thread.
 //!
-//! What is left to trust: a resealed change whose effect lies only between
-//! the sampled LoDs of its band (a label moved by one, a node brought in
-//! and dropped again inside the band) is caught only when the random LoD
-//! falls there; `mts verify --lods all` checks every LoD. Checking every
-//! LoD at load time would cost what that verification costs (seconds on
-//! large models); a user who trusts nothing loads the recipe-only file,
-//! which builds the model from the recipe.
+//! **Why not more.** Each sampled LoD costs a pass over its triangles on
+//! each side. Measured on the bunny, in the same run as the loader without
+//! the check (about 10 ms on this 2-core machine that day): LoD 0 and one
+//! drawn LoD add 2–3 ms; three LoDs of every band (replayed incrementally
+//! with per-vertex triangle lists) made the load 2.2 × as long, every
+//! band's first LoD by representatives 3 ×, and the LoD table checked at
+//! every LoD (each triangle's death found by climbing the forest) 8 ms on
+//! its own (`docs/experiments/ready-file-trust.md`). So a resealed change
+//! whose effect lies elsewhere (a node of a later band, a label moved by
+//! one, a table entry past LoD 0) can load: about one single-field change
+//! in seven to the records of a small model is refused.
+//! `mts verify --lods all` checks every LoD, and a user who trusts no
+//! ready section loads the recipe-only file, which builds the model from
+//! the recipe.
 
 use super::MtsModel;
 use crate::encoding::{is_degenerate, RESTART_U32};
@@ -122,103 +123,111 @@ impl TriangleKey {
 }
 
 impl TriangleKey {
-    /// The LoDs of band `b` (LoDs `first..=last`) whose triangles loading
-    /// compares: its first and last, and one between drawn with the key;
-    /// ascending, without repeats.
-    pub(crate) fn band_samples(&self, b: usize, first: u32, last: u32) -> Vec<u32> {
-        let span = u64::from(last - first) + 1;
-        let drawn =
-            first + (mix(self.k1 ^ (b as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)) % span) as u32;
-        let mut lods = vec![first, drawn, last];
-        lods.sort_unstable();
-        lods.dedup();
-        lods
+    /// The LoDs loading compares, per band of `bands` (each band's first
+    /// LoD): LoD 0, and one drawn with the key from all of `1..=max_lod`
+    /// (so a band is drawn in proportion to its LoDs).
+    pub(crate) fn samples(&self, bands: &[u32], max_lod: u32) -> Vec<Vec<u32>> {
+        let mut samples = vec![Vec::new(); bands.len()];
+        if bands.is_empty() {
+            return samples;
+        }
+        samples[0].push(bands[0]);
+        if max_lod > 0 {
+            let lod = 1 + (mix(self.k1 ^ 0x5a5a) % u64::from(max_lod)) as u32;
+            let band = bands.partition_point(|&first| first <= lod).max(1) - 1;
+            if samples[band].last() != Some(&lod) {
+                samples[band].push(lod);
+            }
+        }
+        samples
     }
 }
 
-/// No entry: the end of a vertex's triangle list.
-const NONE: u32 = u32::MAX;
-
-/// Replays `model`'s recipe: the digest of its triangles at each of
-/// `samples` (ascending LoDs), after checking the LoD → triangle table
-/// against the live triangles at every LoD.
+/// The digest of the recipe's triangles at each of `samples` (ascending
+/// LoDs), after checking that the LoD → triangle table gives their counts
+/// there: the LoD-0 strips' triangles with their vertices replaced by their
+/// representatives at the sample (climbs of the contraction forest with
+/// path compression, valid because samples ascend), degenerate ones
+/// dropped for good. Allocation: the LoD-0 triangles and a `u32` per
+/// vertex.
 ///
 /// # Errors
-/// The first LoD whose table entry differs from the replay's count.
+/// A recipe triangle past the vertices, or the first sample whose table
+/// entry differs from the replay's count.
 ///
-/// Cost: O(triangles + vertices + the triangles moved by all
-/// contractions); three `u32` per triangle corner and one per vertex.
+/// Cost: O(triangles alive at the sample) per sample, amortised climbs.
 pub(crate) fn replay_digests(
     model: &MtsModel,
     key: &TriangleKey,
     samples: &[u32],
 ) -> Result<Vec<Digest>, String> {
-    let collapses = model.collapses();
-    let table = collapses.triangle_counts();
-    let vertices = model.positions.len();
-    let mut triangles = model.recipe.strips.triangles();
-    // Per vertex, its triangles as a list through the corners: entry
-    // 3t + c is corner c of triangle t, `next` links the corners of one
-    // vertex, `head` starts each list.
-    let mut head = vec![NONE; vertices];
-    let mut next = vec![NONE; 3 * triangles.len()];
-    let mut digest = Digest::default();
-    for (t, tri) in triangles.iter().enumerate() {
-        if tri.iter().any(|&v| v as usize >= vertices) {
-            return Err(format!(
-                "the recipe's triangle {t} names a vertex past {vertices}"
-            ));
-        }
-        for (c, &v) in tri.iter().enumerate() {
-            let e = 3 * t + c;
-            next[e] = head[v as usize];
-            head[v as usize] = e as u32;
-        }
-        digest.sum = digest.sum.wrapping_add(key.hash(*tri));
-        digest.count += 1;
+    if samples.is_empty() {
+        return Ok(Vec::new());
     }
+    let collapses = model.collapses();
+    let (parent, from) = (&collapses.parent, &collapses.parent_from_lod);
+    let table = collapses.triangle_counts();
+    let vertices = parent.len().min(from.len());
+    let mut alive = model.recipe.strips.triangles();
+    if let Some(t) = alive
+        .iter()
+        .position(|t| t.iter().any(|&v| v as usize >= vertices))
+    {
+        return Err(format!(
+            "the recipe's triangle {t} names a vertex past {vertices}"
+        ));
+    }
+    // `up[v]`: a vertex whose representative is `v`'s at every LoD from
+    // the last sample on.
+    let mut up: Vec<u32> = (0..vertices as u32).collect();
+    let mut path = Vec::new();
     let mut digests = Vec::with_capacity(samples.len());
-    let mut samples = samples.iter().peekable();
-    for (lod, &expected) in table.iter().enumerate() {
-        if lod > 0 {
-            for (from, to) in collapses.moves(lod - 1) {
-                if from == to || from as usize >= vertices || to as usize >= vertices {
-                    continue;
-                }
-                let mut e = std::mem::replace(&mut head[from as usize], NONE);
-                while e != NONE {
-                    let following = next[e as usize];
-                    let (t, c) = (e as usize / 3, e as usize % 3);
-                    let tri = &mut triangles[t];
-                    // A dead triangle keeps its entries until their vertex
-                    // moves; its corners no longer name that vertex.
-                    if tri[c] == from {
-                        digest.sum = digest.sum.wrapping_sub(key.hash(*tri));
-                        tri[c] = to;
-                        if is_degenerate(*tri) {
-                            *tri = [NONE; 3];
-                            digest.count -= 1;
-                        } else {
-                            digest.sum = digest.sum.wrapping_add(key.hash(*tri));
-                            next[e as usize] = head[to as usize];
-                            head[to as usize] = e;
-                        }
-                    }
-                    e = following;
+    for &lod in samples {
+        // Jumps along `up` (set to a representative at this or an earlier
+        // sample, which stays one later on), then climbs the forest; every
+        // vertex passed then points at the end.
+        let mut find = |v: u32| {
+            let mut r = v;
+            while path.len() <= vertices {
+                let u = up[r as usize];
+                if u != r {
+                    path.push(r);
+                    r = u;
+                } else if from[r as usize] <= lod {
+                    path.push(r);
+                    r = parent[r as usize];
+                } else {
+                    break;
                 }
             }
-        }
-        if u64::from(expected) != digest.count {
+            for &p in &path {
+                up[p as usize] = r;
+            }
+            path.clear();
+            r
+        };
+        let mut d = Digest::default();
+        // Degenerate triangles stay so: they are dropped for good.
+        alive.retain_mut(|t| {
+            if lod > 0 {
+                *t = t.map(&mut find);
+            }
+            let keep = !is_degenerate(*t);
+            if keep {
+                d.sum = d.sum.wrapping_add(key.hash(*t));
+                d.count += 1;
+            }
+            keep
+        });
+        let expected = table.get(lod as usize).copied().unwrap_or(0);
+        if u64::from(expected) != d.count {
             return Err(format!(
                 "the LoD → triangle table says {expected} triangles at LoD {lod}, the recipe's \
                  replay has {}",
-                digest.count
+                d.count
             ));
         }
-        while samples.peek().is_some_and(|&&l| l as usize == lod) {
-            samples.next();
-            digests.push(digest);
-        }
+        digests.push(d);
     }
     Ok(digests)
 }

@@ -323,8 +323,7 @@ impl MtsModel {
     /// [`crate::Invalid`] naming the first broken one (strip, node or arc).
     pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
         let key = digest::TriangleKey::random();
-        let first: Vec<Vec<u32>> = self.band_lod.iter().map(|&l| vec![l]).collect();
-        self.check_parts(&key, &first)
+        self.check_parts(&key, &vec![Vec::new(); self.band_count()])
             .map(drop)
             .map_err(|message| crate::Invalid {
                 structure: "MtsModel",
@@ -333,19 +332,21 @@ impl MtsModel {
     }
 
     /// [`MtsModel::validate`], and that the model draws what its recipe
-    /// replays at the first LoD of every band, with the recipe's triangle
-    /// count at every LoD: what loading a ready `.mts` checks (the
-    /// decision and what it leaves to trust: `model/digest.rs`).
+    /// replays, with its LoD table's triangle counts, at LoD 0 and at one
+    /// LoD drawn at random: what loading a ready `.mts` checks (the
+    /// decision, its cost and what it leaves to trust: `model/digest.rs`).
     ///
     /// # Errors
     /// [`crate::Invalid`] naming the first broken invariant, or the band
     /// (or LoD) where the model and its recipe disagree.
     ///
-    /// Cost: [`MtsModel::validate`]'s, with the recipe's replay (O(triangles
-    /// + the triangles the contractions move)) on a second thread.
+    /// Cost: [`MtsModel::validate`]'s, a hash of the triangles of the two
+    /// sampled LoDs on each side, one more walk of one band's strips, and
+    /// the recipe's triangles mapped to the drawn LoD (on a second
+    /// thread).
     pub fn validate_against_recipe(&self) -> std::result::Result<(), crate::Invalid> {
         let key = digest::TriangleKey::random();
-        let samples = self.band_samples(&key);
+        let samples = key.samples(&self.band_lod, self.max_lod() as u32);
         let flat: Vec<u32> = samples.iter().flatten().copied().collect();
         let (walked, replayed) = std::thread::scope(|scope| {
             let replay = scope.spawn(|| digest::replay_digests(self, &key, &flat));
@@ -378,19 +379,6 @@ impl MtsModel {
             }
         }
         Ok(())
-    }
-
-    /// Per band, the LoDs [`MtsModel::validate_against_recipe`] compares
-    /// ([`digest::TriangleKey::band_samples`]).
-    fn band_samples(&self, key: &digest::TriangleKey) -> Vec<Vec<u32>> {
-        let max_lod = self.max_lod() as u32;
-        (0..self.band_count())
-            .map(|b| {
-                let first = self.band_lod[b];
-                let last = self.band_lod.get(b + 1).map_or(max_lod, |&next| next - 1);
-                key.band_samples(b, first, last.max(first))
-            })
-            .collect()
     }
 
     /// The structure checks; returns, per band, the digest of the
