@@ -37,8 +37,11 @@
 //! **Memory.** An instance holds its transform, bounds, scale, bucket and
 //! LoD (plus its share of the BVH and the per-update lists); the GPU holds
 //! the live buckets' index buffers, one instance buffer and each model's
-//! vertices. See [`InstancedScene::memory`]. The ground, the layout and the
-//! camera of `mts render --scene` live in the CLI.
+//! vertices. See [`InstancedScene::memory`]. A model's slots go when its
+//! last instance is removed, and the lists and the instance buffer at the
+//! first update with no instance, so an emptied scene holds what a new one
+//! with the same models does. The ground, the layout and the camera of
+//! `mts render --scene` live in the CLI.
 
 use super::camera::Camera;
 use super::gpu::StripMode;
@@ -48,6 +51,7 @@ use glam::{Mat4, Vec3, Vec4};
 use mts::model::Extractor;
 use mts::strip::encode::stitch_restart_buffer;
 use mts::{Error, MtsModel, Result};
+use std::ops::Range;
 
 /// The default of [`InstancedScene::set_bucket_spacing`]: each bucket has
 /// about 10% fewer triangles than the next finer one.
@@ -108,6 +112,31 @@ pub struct FrameStats {
     pub upload_bytes: usize,
     /// Whether the instance BVH was rebuilt, refitted or kept.
     pub bvh: BvhUpdate,
+}
+
+/// One instanced draw of the last [`InstancedScene::update`]: a (model,
+/// bucket) group ([`InstancedScene::draw_groups`]), for hosts and tests
+/// that check what the GPU is given.
+#[derive(Debug, Clone)]
+pub struct DrawGroup<'a> {
+    /// The model drawn.
+    pub model: ModelId,
+    /// The bucket's LoD.
+    pub lod: usize,
+    /// Indices [`InstancedScene::draw`] reads from `indices`: the compact
+    /// strips of `lod` (stitched on [`StripMode::Stitched`]); a group of 0
+    /// is not drawn.
+    pub index_count: u32,
+    /// The bucket's index buffer (restart `0xFFFF` or `u32::MAX`; a `u16`
+    /// buffer of an odd count ends with one more restart). It can be
+    /// copied from.
+    pub indices: &'a wgpu::Buffer,
+    /// The format of `indices` (the model renderer's).
+    pub index_format: wgpu::IndexFormat,
+    /// The group's transforms in [`InstancedScene::instance_buffer`], in
+    /// [`INSTANCE_BYTES`] entries: the visible instances of the model that
+    /// draw this bucket, ascending by id.
+    pub instances: Range<u32>,
 }
 
 /// What an update did to the instance BVH.
@@ -337,7 +366,10 @@ impl<'m> InstancedScene<'m> {
         let renderer =
             StripRenderer::for_model_with(device, queue, &self.config, model, appearance)?;
         let (min, max) = mts::mesh::bounds_of(model.positions()).unwrap_or_default();
-        let diagonal = mts::mesh::diagonal_of(min, max) as f32;
+        // A model wider than f32 can say (coordinates near f32::MAX) gets
+        // the largest finite bound, so that a transform that scales it down
+        // still places it.
+        let diagonal = (mts::mesh::diagonal_of(min, max) as f32).min(f32::MAX);
         let radius = (diagonal * 0.5).max(f32::MIN_POSITIVE);
         self.models.push(ModelEntry {
             model,
@@ -439,6 +471,12 @@ impl<'m> InstancedScene<'m> {
         slot.live = false;
         slot.bucket = NONE;
         entry.free.push(id.slot);
+        if entry.free.len() == entry.slots.len() {
+            // The model's last instance: its slots are given back (a
+            // removed id then finds no slot).
+            entry.slots = Vec::new();
+            entry.free = Vec::new();
+        }
         self.live -= 1;
         self.rebuild = true;
         true
@@ -462,6 +500,34 @@ impl<'m> InstancedScene<'m> {
     #[must_use]
     pub fn visible(&self) -> &[InstanceId] {
         &self.visible
+    }
+
+    /// The instanced draws of the last update, in the order
+    /// [`InstancedScene::draw`] records them (models as added, buckets
+    /// finest first). Cost: O(buckets of all models); no allocation.
+    pub fn draw_groups(&self) -> impl Iterator<Item = DrawGroup<'_>> + '_ {
+        self.models.iter().enumerate().flat_map(|(m, entry)| {
+            entry.buckets.iter().filter_map(move |b| {
+                let indices = b.buffer.as_ref().filter(|_| b.users > 0)?;
+                Some(DrawGroup {
+                    model: ModelId(m as u32),
+                    lod: b.lod as usize,
+                    index_count: b.len,
+                    indices,
+                    index_format: entry.renderer.index_format(),
+                    instances: b.first..b.first + b.users,
+                })
+            })
+        })
+    }
+
+    /// The visible instances' transforms of the last update (column-major
+    /// `f32` 4 × 4, [`INSTANCE_BYTES`] each, grouped as
+    /// [`InstancedScene::draw_groups`] says); `None` before the first
+    /// update with a visible instance. It can be copied from.
+    #[must_use]
+    pub fn instance_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.instance_buffer.as_ref()
     }
 
     /// The LoD instance `id` drew in the last update (its bucket's), `None`
@@ -681,6 +747,17 @@ impl<'m> InstancedScene<'m> {
         }
         stats.upload_bytes += self.write_transforms(device, queue, groups as usize)?;
         stats.visible = self.visible.len();
+        if self.live == 0 {
+            // Emptied: the per-update lists and the instance buffer are
+            // given back, as a new scene has none.
+            self.order = Vec::new();
+            self.stack = Vec::new();
+            self.candidates = Vec::new();
+            self.visible = Vec::new();
+            self.previous = Vec::new();
+            self.instance_buffer = None;
+            self.instance_capacity = 0;
+        }
         Ok(stats)
     }
 
@@ -709,7 +786,10 @@ impl<'m> InstancedScene<'m> {
             self.instance_buffer = Some(device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("mts scene instances"),
                 size: bytes,
-                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                // COPY_SRC: readable by hosts and tests (`instance_buffer`).
+                usage: wgpu::BufferUsages::VERTEX
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }));
             self.instance_capacity = capacity;
@@ -853,7 +933,10 @@ fn index_buffer(
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("mts scene bucket"),
         size,
-        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
+        // COPY_SRC: readable by hosts and tests (`draw_groups`).
+        usage: wgpu::BufferUsages::INDEX
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
     let bytes = if indices.is_empty() {
@@ -882,9 +965,14 @@ fn aabb(b: Bound) -> obvhs::aabb::Aabb {
 /// the transform's largest axis scale (which bounds a uniform or
 /// non-uniform scale).
 fn place(local: Bound, transform: Mat4) -> Result<(Bound, f32)> {
+    // A column of tiny (denormal) or huge entries has a square that
+    // underflows or overflows in f32: its length is then taken in f64.
     let scale = [transform.x_axis, transform.y_axis, transform.z_axis]
         .iter()
-        .map(|c| c.truncate().length())
+        .map(|c| match c.truncate().length() {
+            l if l == 0.0 || l.is_infinite() => c.truncate().as_dvec3().length() as f32,
+            l => l,
+        })
         .fold(0.0f32, f32::max);
     let bound = Bound {
         centre: transform.transform_point3(local.centre),

@@ -113,6 +113,11 @@ fn a_seam_a_material_texture_and_a_missing_library() {
                usemtl checker\nf 1/1/1 2/2/1 3/3/1\nf 1/5/1 3/6/1 4/4/1\n";
     let path = dir.join("seam.obj");
     std::fs::write(&path, obj).unwrap();
+    // A texture file that does not exist is a warning: the mesh is read
+    // untextured (a later .glb write or draw has nothing to read).
+    let (missing, _) = load(&path, with_properties()).unwrap();
+    assert_eq!(missing.properties.texture, None);
+    std::fs::write(dir.join("checker.png"), b"not read by the loader").unwrap();
     let (mesh, _) = load(&path, with_properties()).unwrap();
     assert_eq!(mesh.vertex_count(), 6);
     assert_eq!(mesh.properties.position_ids, vec![0, 1, 2, 0, 2, 3]);
