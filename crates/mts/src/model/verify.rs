@@ -6,7 +6,8 @@
 //! (position ids) it also checks that no contraction tears one: once a
 //! point is contracted away, none of its vertices is drawn (every one
 //! moved with it). Drawn vertices are input vertices, so the drawn
-//! triangles' properties are the oracle's whenever their indices are.
+//! triangles' properties are the oracle's whenever their indices are. The
+//! LoD → triangle table is checked against the replay's count too.
 //!
 //! Checking every LoD of a 70K-triangle model naively would cost
 //! O(LoDs × triangles) for the oracle alone. Both sides are kept
@@ -127,6 +128,12 @@ pub fn verify(model: &MtsModel, mesh: &Mesh, lods: &[usize]) -> VerifyReport {
             problem = Some(format!(
                 "a seam is torn: contraction {step} moved its point without vertex {w}, still drawn"
             ));
+        } else if oracle.alive != model.triangle_count(lod) {
+            problem = Some(format!(
+                "the LoD table says {} triangles, the replay has {}",
+                model.triangle_count(lod),
+                oracle.alive
+            ));
         } else if tally.nonzero != 0 {
             problem = Some(format!(
                 "the strips draw {} oriented triangles in other numbers than the replay",
@@ -213,6 +220,8 @@ struct Oracle<'m> {
     model: &'m MtsModel,
     lod: usize,
     current: Vec<[u32; 3]>,
+    /// Triangles of `current` that are not degenerate.
+    alive: usize,
     incident: Vec<Vec<u32>>,
     /// On a model with seams: the vertices of each point (CSR over the
     /// position ids), to see that a contraction leaves none of the removed
@@ -244,6 +253,7 @@ impl<'m> Oracle<'m> {
             model,
             lod: 0,
             current: mesh.triangles.clone(),
+            alive: mesh.triangles.iter().filter(|&&t| !is_degenerate(t)).count(),
             incident,
             point_start,
             point_vertices,
@@ -304,7 +314,9 @@ impl<'m> Oracle<'m> {
                     *v = to;
                 }
             }
-            if !is_degenerate(*t) {
+            if is_degenerate(*t) {
+                self.alive -= 1;
+            } else {
                 tally.add(*t, -1);
                 keep.push(ti);
             }
