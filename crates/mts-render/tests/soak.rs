@@ -790,7 +790,7 @@ impl<'g, 'm> Soak<'g, 'm> {
         if count > 0 {
             let buffer = self.scene.instance_buffer().expect("instances drawn");
             let bytes = read_back(self.gpu, buffer, (count * INSTANCE_BYTES as usize) as u64);
-            let mut want = Vec::with_capacity(bytes.len());
+            let mut want: Vec<u8> = Vec::with_capacity(bytes.len());
             for (k, b, _) in groups {
                 let mut ids: Vec<(InstanceId, Mat4)> = self
                     .placed

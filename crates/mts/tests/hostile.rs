@@ -289,3 +289,122 @@ fn loader_fuzz_regressions_stay_fixed() {
     }
     eprintln!("{seen} loader fuzz inputs");
 }
+
+/// Random numbers below `below` from a fixed linear congruential sequence.
+fn lcg(seed: u64, below: u32) -> impl FnMut() -> u32 {
+    let mut state = seed;
+    move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((state >> 33) as u32) % below
+    }
+}
+
+/// `vertices` vertices at random points of the unit cube, and `triangles`
+/// made of them by `corners`.
+fn random_mesh(
+    vertices: u32,
+    corners: impl FnOnce(&mut dyn FnMut() -> u32) -> Vec<[u32; 3]>,
+) -> Mesh {
+    let mut coordinate = lcg(7, 1 << 30);
+    let positions = (0..vertices)
+        .map(|_| {
+            Vec3::new(
+                coordinate() as f32,
+                coordinate() as f32,
+                coordinate() as f32,
+            ) / 2f32.powi(30)
+        })
+        .collect();
+    let mut index = lcg(31, vertices);
+    Mesh {
+        positions,
+        triangles: corners(&mut index),
+        properties: Default::default(),
+    }
+}
+
+/// Issue 31: 20,000 distinct triangles over 256 vertices (every vertex in
+/// about 234 triangles, every pair of vertices a common neighbour, edges of
+/// one to a dozen triangles), and a triangle strip of 30,000 random
+/// one-byte indices (a glTF TRIANGLE_STRIP of 4M such indices is 2.7M
+/// distinct triangles; here every edge holds about 2.7 triangles, and
+/// triangles repeat). The first took 12 to 21 s, its guards and choices
+/// scanning whole fans once per neighbour; each vertex's neighbours are
+/// now tallied once per change of its fan. Random triangles cross every
+/// edge with others, so nearly every contraction would make an edge more
+/// crowded than the input's most crowded one and the sequences stop early,
+/// at the LoDs and with the refusals that the scans found (the release
+/// CLI before the change: same stops, same models).
+#[test]
+fn dense_non_manifold_meshes_simplify_as_before() {
+    let distinct = random_mesh(256, |index| {
+        let mut seen = std::collections::HashSet::new();
+        let mut triangles = Vec::new();
+        while triangles.len() < 20_000 {
+            let t = [index(), index(), index()];
+            let mut key = t;
+            key.sort_unstable();
+            if key[0] != key[1] && key[1] != key[2] && seen.insert(key) {
+                triangles.push(t);
+            }
+        }
+        triangles
+    });
+    let strip = random_mesh(256, |index| {
+        let s: Vec<u32> = (0..30_000).map(|_| index()).collect();
+        (0..s.len() - 2)
+            .map(|i| {
+                if i % 2 == 0 {
+                    [s[i], s[i + 1], s[i + 2]]
+                } else {
+                    [s[i + 1], s[i], s[i + 2]]
+                }
+            })
+            .filter(|&t| !mts::mesh::is_degenerate(t))
+            .collect()
+    });
+    assert_eq!(strip.triangle_count(), 29_696);
+    // Where each sequence stopped (every candidate of its last round
+    // refused), and its triangle counts.
+    let stop = |lod, triangles, vertices, candidates_left, rejected_flip, rejected_topology| {
+        mts::simplify::Stop {
+            reason: mts::simplify::StopReason::NoValidPair,
+            lod,
+            triangles,
+            vertices,
+            candidates_left,
+            rejected_flip,
+            rejected_topology,
+        }
+    };
+    let expected: [(_, &[u32]); 2] = [
+        (
+            stop(10, 19_971, 246, 51_540, 1_594, 49_946),
+            &[
+                20_000, 19_997, 19_994, 19_991, 19_990, 19_989, 19_986, 19_983, 19_980, 19_974,
+                19_971,
+            ],
+        ),
+        (
+            stop(4, 29_679, 252, 53_348, 5_472, 47_876),
+            &[29_696, 29_691, 29_688, 29_682, 29_679],
+        ),
+    ];
+    for (m, (stop, counts)) in [&distinct, &strip].into_iter().zip(expected) {
+        m.validate().unwrap();
+        let options = SimplifyOptions {
+            stop_at_triangles: Some(m.triangle_count() / 10),
+            ..Default::default()
+        };
+        let s = mts::simplify(m, &options);
+        s.collapses.validate().unwrap();
+        assert_eq!(s.stop, stop);
+        assert_eq!(s.collapses.triangle_counts(), counts);
+        let (model, _, _) = mts::model::build_from_mesh(m, &Default::default(), &mut |_, _| {});
+        assert_eq!(model.max_lod(), stop.lod);
+        let lods: Vec<usize> = (0..=model.max_lod()).collect();
+        assert_eq!(mts::model::verify(&model, m, &lods).mismatches, 0);
+    }
+}

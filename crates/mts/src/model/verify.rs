@@ -253,7 +253,11 @@ impl<'m> Oracle<'m> {
             model,
             lod: 0,
             current: mesh.triangles.clone(),
-            alive: mesh.triangles.iter().filter(|&&t| !is_degenerate(t)).count(),
+            alive: mesh
+                .triangles
+                .iter()
+                .filter(|&&t| !is_degenerate(t))
+                .count(),
             incident,
             point_start,
             point_vertices,

@@ -6,7 +6,8 @@
 //! counts and the naive replay at any LoD. `quadric.rs` holds the error
 //! quadrics, `pairs.rs` the candidate pairs, and `queue.rs`, `fans.rs`
 //! and `refusals.rs` the loop's flat structures: the priority queue, the
-//! triangles around each vertex and the targets a guard refused.
+//! triangles around each vertex (and the neighbours of wide fans) and the
+//! targets a guard refused.
 
 mod collapses;
 mod contract;

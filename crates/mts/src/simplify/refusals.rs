@@ -70,6 +70,18 @@ impl Refusals {
         false
     }
 
+    /// Calls `f` with each target refused to `v` (a target refused twice,
+    /// twice). O(their number).
+    #[inline]
+    pub(crate) fn for_each(&self, v: u32, mut f: impl FnMut(u32)) {
+        let mut e = self.head[v as usize];
+        while e != NIL {
+            let (t, next) = self.pool[e as usize];
+            f(t);
+            e = next;
+        }
+    }
+
     /// Records that `v`'s contraction onto `target` was refused.
     pub(crate) fn add(&mut self, v: u32, target: u32) {
         let entry = (target, self.head[v as usize]);
@@ -128,5 +140,10 @@ mod tests {
         assert_eq!(r.pool.len(), 4);
         assert!(r.contains(3, 1) && r.contains(1, 5) && !r.contains(3, 2));
         assert_eq!(r.count(), 4);
+        r.add(1, 5);
+        let mut listed = Vec::new();
+        r.for_each(1, |t| listed.push(t));
+        listed.sort_unstable();
+        assert_eq!(listed, [2, 5, 5]);
     }
 }

@@ -17,8 +17,15 @@ impl<P: Place> Contractor<P> {
     /// Recomputes `v`'s cheapest contraction and queues it when it changed
     /// (the old entry then goes stale).
     pub(super) fn refresh(&mut self, v: u32) {
-        // Drop the triangles that died around `v` while it stayed.
-        self.fans.retain(v, |t| self.tris[t as usize][0] != DEAD);
+        // Drop the triangles that died around `v` while it stayed (a wide
+        // fan's current star says none did).
+        if self.fans.get(v).len() > WIDE {
+            let tris = &self.tris;
+            self.stars
+                .update(v, &mut self.fans, tris, |t| tris[t as usize][0] != DEAD);
+        } else {
+            self.fans.retain(v, |t| self.tris[t as usize][0] != DEAD);
+        }
         let new = P::best(self, v).map_or((f32::INFINITY, NONE), |(c, w)| (c as f32, w));
         let old = self.queued[v as usize];
         if new.0 != old.0 || new.1 != old.1 {
@@ -69,18 +76,25 @@ impl<P: Place> Contractor<P> {
     }
 
     /// Appends every current neighbour and virtual partner of `v` to `out`,
-    /// once each, in fan order.
+    /// once each, in fan order (from `v`'s star when it is current).
     pub(super) fn partners_into(&mut self, v: u32, out: &mut Vec<u32>) {
         let epoch = self.next_epoch();
-        for &t in self.fans.get(v) {
-            let tri = self.tris[t as usize];
-            if tri[0] == DEAD {
-                continue;
+        if let Some(star) = self.stars.get(v) {
+            for &w in star.neighbours() {
+                self.mark[w as usize] = epoch;
+                out.push(w);
             }
-            for w in tri {
-                if w != v && self.mark[w as usize] != epoch {
-                    self.mark[w as usize] = epoch;
-                    out.push(w);
+        } else {
+            for &t in self.fans.get(v) {
+                let tri = self.tris[t as usize];
+                if tri[0] == DEAD {
+                    continue;
+                }
+                for w in tri {
+                    if w != v && self.mark[w as usize] != epoch {
+                        self.mark[w as usize] = epoch;
+                        out.push(w);
+                    }
                 }
             }
         }
@@ -92,6 +106,16 @@ impl<P: Place> Contractor<P> {
                 }
             }
         }
+    }
+
+    /// Marks the targets refused to `v` with a fresh epoch, which it
+    /// returns: a question per target instead of a walk of the list (a
+    /// vertex of a dense mesh is refused hundreds of targets).
+    pub(super) fn mark_refusals(&mut self, v: u32) -> u32 {
+        let epoch = self.next_epoch();
+        let mark = &mut self.mark;
+        self.refusals.for_each(v, |w| mark[w as usize] = epoch);
+        epoch
     }
 
     pub(super) fn next_epoch(&mut self) -> u32 {
@@ -115,7 +139,8 @@ impl Contractor<Endpoint> {
     /// vertex.
     pub(super) fn best_endpoint(&self, v: u32) -> Option<(f64, u32)> {
         /// Fans up to this many triangles are deduplicated on the stack;
-        /// larger ones cost every occurrence.
+        /// larger ones cost every occurrence (or each neighbour once, from
+        /// a current star: [`Contractor::best_endpoint_wide`]).
         const FAN: usize = 24;
         let q = &self.quadrics[v as usize];
         let (centre, squares) = self.place.anchors[v as usize]
@@ -178,6 +203,107 @@ impl Contractor<Endpoint> {
                 if !self.removed[w as usize] {
                     consider(w);
                 }
+            }
+        }
+        best
+    }
+
+    /// [`Contractor::cost`] of `v → w` with `v`'s quadric `q` and the
+    /// centre of its anchor (the tie-break's, computed once per choice), as
+    /// [`Contractor::best_endpoint`] computes it (there written out: its
+    /// closure compiled to more instructions calling this).
+    #[inline(always)]
+    fn endpoint_cost(&self, q: &Quadric, centre: DVec3, squares: f64, v: u32, w: u32) -> f64 {
+        let p = self.p(w);
+        let mut cost = q.mean_error(p) + TIE_BREAK * PointSum::spread(p, centre, squares);
+        if let Some(a) = &self.attributes {
+            cost += a.cost(v, w, p);
+        }
+        cost
+    }
+
+    /// [`Contractor::best_endpoint`] of a vertex whose star is current:
+    /// the first target no guard refused in the star's ranking of its
+    /// neighbours by `(cost, index)`, which is their minimum. The ranking
+    /// is made once per star (a vertex of a dense mesh chooses again after
+    /// each of hundreds of refusals, and costing every neighbour each time
+    /// was most of its sequence's time). O(valence + refusals) per choice,
+    /// O(valence · log valence) per star; where the scan cost O(fan ·
+    /// refusals).
+    ///
+    /// Costs that change while the star stays current (attribute costs,
+    /// which read the target's state, and virtual partners, which come and
+    /// go without a triangle changing) are costed per choice instead, each
+    /// distinct neighbour once ([`Contractor::best_among`]), and so are
+    /// NaN costs, which have no rank.
+    pub(super) fn best_endpoint_wide(&mut self, v: u32) -> Option<(f64, u32)> {
+        let refused = if self.refusals.is_empty(v) {
+            None
+        } else {
+            Some(self.mark_refusals(v))
+        };
+        let is_refused = |c: &Self, w: u32| refused.is_some_and(|e| c.mark[w as usize] == e);
+        if self.attributes.is_some() || !self.partners.is_empty() {
+            return self.best_among(v, is_refused);
+        }
+        if !self.stars.current(v).ranked {
+            let q = &self.quadrics[v as usize];
+            let (centre, squares) = self.place.anchors[v as usize]
+                .centre()
+                .unwrap_or((DVec3::ZERO, 0.0));
+            let mut ranking = std::mem::take(&mut self.stars.current_mut(v).ranking);
+            ranking.clear();
+            for &w in self.stars.current(v).neighbours() {
+                ranking.push((self.endpoint_cost(q, centre, squares, v, w), w));
+            }
+            if ranking.iter().any(|(cost, _)| cost.is_nan()) {
+                ranking.clear();
+            } else {
+                // As the scan compares: -0 and 0 tie, and go by index.
+                ranking.sort_unstable_by(|x, y| {
+                    x.0.partial_cmp(&y.0)
+                        .unwrap_or(std::cmp::Ordering::Equal)
+                        .then(x.1.cmp(&y.1))
+                });
+            }
+            let star = self.stars.current_mut(v);
+            (star.ranking, star.ranked) = (ranking, true);
+        }
+        let star = self.stars.current(v);
+        if star.ranking.is_empty() && !star.neighbours().is_empty() {
+            return self.best_among(v, is_refused);
+        }
+        star.ranking
+            .iter()
+            .find(|&&(_, w)| !is_refused(self, w))
+            .copied()
+    }
+
+    /// The cheapest of `v`'s star's neighbours and its live virtual
+    /// partners for which `refused` fails, ties to the lower index, each
+    /// costed in the order a scan of the fan meets it (so a NaN cost
+    /// decides as it does in [`Contractor::best_endpoint`]).
+    fn best_among(&self, v: u32, refused: impl Fn(&Self, u32) -> bool) -> Option<(f64, u32)> {
+        let q = &self.quadrics[v as usize];
+        let (centre, squares) = self.place.anchors[v as usize]
+            .centre()
+            .unwrap_or((DVec3::ZERO, 0.0));
+        let mut best: Option<(f64, u32)> = None;
+        let partners = self.partners.get(v as usize).map_or(&[][..], Vec::as_slice);
+        let live_partners = partners.iter().filter(|&&w| !self.removed[w as usize]);
+        for &w in self
+            .stars
+            .current(v)
+            .neighbours()
+            .iter()
+            .chain(live_partners)
+        {
+            if refused(self, w) {
+                continue;
+            }
+            let cost = self.endpoint_cost(q, centre, squares, v, w);
+            if best.is_none_or(|(bc, bw)| cost < bc || (cost == bc && w < bw)) {
+                best = Some((cost, w));
             }
         }
         best

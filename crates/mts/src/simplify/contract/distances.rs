@@ -296,8 +296,11 @@ impl<P: Place> Contractor<P> {
     }
 
     /// Live triangles around `a` on edge `(a, x)` (`a`'s list holds every
-    /// triangle on the edge).
+    /// triangle on the edge); from `a`'s star when it is current.
     pub(super) fn triangles_on(&self, a: u32, x: u32) -> usize {
+        if let Some(star) = self.stars.get(a) {
+            return star.count(x);
+        }
         self.fans
             .get(a)
             .iter()

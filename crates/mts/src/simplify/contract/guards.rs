@@ -70,13 +70,17 @@ pub(super) fn creased(fan: &[Turn]) -> bool {
 pub(super) fn border_slots(tris: &[[u32; 3]], fans: &Fans) -> Vec<u8> {
     const LOCAL: usize = 32;
     let mut out = vec![0u8; tris.len()];
+    let mut holders: Vec<(u32, u32, u8)> = Vec::new();
+    let mut opposite: Vec<u32> = Vec::new();
     for a in 0..fans.vertex_count() as u32 {
         let around = fans.get(a);
         if around.len() > LOCAL {
             // Sorted instead of scanned per corner: linearithmic in the
-            // fan (a 100,000-triangle fan took seconds by the scan).
-            let mut holders: Vec<(u32, u32, u8)> = Vec::with_capacity(around.len());
-            let mut opposite: Vec<u32> = Vec::with_capacity(around.len());
+            // fan (a 100,000-triangle fan took seconds by the scan), the
+            // holders of each `b` matched against the opposite run of `b`
+            // in one merge.
+            holders.clear();
+            opposite.clear();
             for &t in around {
                 let tri = tris[t as usize];
                 let k = tri.iter().position(|&w| w == a).unwrap_or(0);
@@ -85,15 +89,17 @@ pub(super) fn border_slots(tris: &[[u32; 3]], fans: &Fans) -> Vec<u8> {
             }
             holders.sort_unstable();
             opposite.sort_unstable();
-            let mut rank = 0;
+            let (mut rank, mut count, mut at) = (0, 0, 0);
             for (i, &(b, t, k)) in holders.iter().enumerate() {
-                rank = if i > 0 && holders[i - 1].0 == b {
-                    rank + 1
+                if i > 0 && holders[i - 1].0 == b {
+                    rank += 1;
                 } else {
-                    0
-                };
-                let count =
-                    opposite.partition_point(|&x| x <= b) - opposite.partition_point(|&x| x < b);
+                    rank = 0;
+                    while opposite.get(at).is_some_and(|&x| x < b) {
+                        at += 1;
+                    }
+                    count = opposite[at..].iter().take_while(|&&x| x == b).count();
+                }
                 if rank >= count {
                     out[t as usize] |= 1 << k;
                 }
@@ -172,8 +178,66 @@ pub(super) fn most_crowded_edge(tris: &[[u32; 3]], fans: &Fans) -> usize {
 
 impl<P: Place> Contractor<P> {
     /// The guards of the module docs for contracting `a` into `b` placed at
-    /// `target`. Allocation-free; O(valence(a) · valence(b)) at worst.
+    /// `target`. Allocation-free (once the stars' buffers have grown);
+    /// O(valence(a) · valence(b)) at worst, the topology rules of wide fans
+    /// from their stars ([`Contractor::topology_wide`]).
     pub(super) fn check(&mut self, a: u32, b: u32, target: DVec3) -> Result<(), Reject> {
+        if self.fans.get(a).len() > WIDE || self.fans.get(b).len() > WIDE {
+            self.topology_wide(a, b)?;
+        } else {
+            self.topology(a, b)?;
+        }
+        // Triangles of `a` that survive: no flipped normal (their turns are
+        // kept for the distance checks).
+        //
+        // A surviving triangle may land on the three vertices of one of
+        // `b`'s (most often its other two corners are the apexes of edge
+        // (a, b): a tetrahedral pocket, a closed part folded flat, or a fin
+        // folding onto its sheet). The pair is a doubled sheet where the
+        // surface is, and the next contraction on it removes both; the
+        // topology rules' merge test still bounds every edge. Refusing it
+        // (as a link condition would) kept beetle's fins standing: at its
+        // floor of 81 triangles 31 edges still held three (meshoptimizer's
+        // 81 keep 3), and its 1% row read 2.33 × meshoptimizer's Hausdorff
+        // (median of 6 vertex orders). Allowed, with the crowding bound of
+        // the merge test: 0.53, the last two rows above 1.15 × pass, the
+        // geometric mean of the 40 rows' medians 0.698 → 0.684 (see
+        // ARCHITECTURE.md).
+        let mut fan = std::mem::take(&mut self.fan);
+        fan.clear();
+        let mut verdict = Ok(());
+        for &t in self.fans.get(a) {
+            let tri = self.tris[t as usize];
+            if self.tris[t as usize][0] == DEAD || tri.contains(&b) {
+                continue;
+            }
+            let Some(turn) = self.turn(t, a, target) else {
+                verdict = Err(Reject::Flip);
+                break;
+            };
+            fan.push(turn);
+        }
+        self.fan = fan;
+        verdict?;
+        if P::MOVES_KEPT {
+            for &t in self.fans.get(b) {
+                let tri = self.tris[t as usize];
+                if self.tris[t as usize][0] != DEAD && !tri.contains(&a) && self.flips(t, b, target)
+                {
+                    return Err(Reject::Flip);
+                }
+            }
+        }
+        if !self.corners.is_empty() && !self.seam_map(a, b) {
+            return Err(Reject::Topology);
+        }
+        Ok(())
+    }
+
+    /// The topology rules of [`Contractor::check`] (the border rule, fins
+    /// and the link condition) for contracting `a` into `b`; sets
+    /// [`Contractor::fan_on_border`]. O(valence(a) · valence(b)) at worst.
+    pub(super) fn topology(&mut self, a: u32, b: u32) -> Result<(), Reject> {
         for &t in self.fans.get(a) {
             prefetch(&self.tris[t as usize]);
             prefetch(&self.normals0[t as usize]);
@@ -268,48 +332,63 @@ impl<P: Place> Contractor<P> {
             }
         }
         self.checked = checked;
-        // Triangles of `a` that survive: no flipped normal (their turns are
-        // kept for the distance checks).
-        //
-        // A surviving triangle may land on the three vertices of one of
-        // `b`'s (most often its other two corners are the apexes of edge
-        // (a, b): a tetrahedral pocket, a closed part folded flat, or a fin
-        // folding onto its sheet). The pair is a doubled sheet where the
-        // surface is, and the next contraction on it removes both; the
-        // merge test above still bounds every edge. Refusing it (as a link
-        // condition would) kept beetle's fins standing: at its floor of 81
-        // triangles 31 edges still held three (meshoptimizer's 81 keep 3),
-        // and its 1% row read 2.33 × meshoptimizer's Hausdorff (median of 6
-        // vertex orders). Allowed, with the crowding bound of the merge
-        // test: 0.53, the last two rows above 1.15 × pass, the geometric
-        // mean of the 40 rows' medians 0.698 → 0.684 (see ARCHITECTURE.md).
-        let mut fan = std::mem::take(&mut self.fan);
-        fan.clear();
-        let mut verdict = Ok(());
-        for &t in self.fans.get(a) {
-            let tri = self.tris[t as usize];
-            if self.tris[t as usize][0] == DEAD || tri.contains(&b) {
-                continue;
-            }
-            let Some(turn) = self.turn(t, a, target) else {
-                verdict = Err(Reject::Flip);
+        Ok(())
+    }
+
+    /// [`Contractor::topology`] read from the stars of `a` and `b` (built
+    /// or kept current here): the same verdict in O(valence(a) +
+    /// valence(b) + k) for the `k` triangles on edge `(a, b)`, whatever the
+    /// widths of the fans. The scans cost each common neighbour a pass
+    /// over both fans: a dense non-manifold mesh (every vertex in
+    /// thousands of triangles, every pair of vertices a common neighbour)
+    /// spent seconds per thousand triangles here.
+    ///
+    /// A common neighbour `w` takes the merge test where the scan meets it:
+    /// on a triangle of `b` without `a`, i.e. where `b`'s triangles on `(b,
+    /// w)` outnumber the `dying` ones on `(a, b, w)`.
+    pub(super) fn topology_wide(&mut self, a: u32, b: u32) -> Result<(), Reject> {
+        let tris = &self.tris;
+        for v in [a, b] {
+            self.stars
+                .update(v, &mut self.fans, tris, |t| tris[t as usize][0] != DEAD);
+        }
+        let (sa, sb) = (self.stars.current(a), self.stars.current(b));
+        // The apexes of edge (a, b), sorted: those of the triangles on (a,
+        // b, w) are the run of `w`.
+        let apexes = sa.thirds(b);
+        self.fan_on_border = sa.border();
+        if sa.slides() && apexes.len() == 2 {
+            return Err(Reject::Topology);
+        }
+        if P::MOVES_KEPT && sb.slides() && apexes.len() == 2 {
+            return Err(Reject::Topology);
+        }
+        let mut around_a = sa.edges().peekable();
+        let mut apex = 0;
+        for (w, on_bw) in sb.edges() {
+            while around_a.next_if(|&(x, _)| x < w).is_some() {}
+            let Some(&(x, on_aw)) = around_a.peek() else {
                 break;
             };
-            fan.push(turn);
-        }
-        self.fan = fan;
-        verdict?;
-        if P::MOVES_KEPT {
-            for &t in self.fans.get(b) {
-                let tri = self.tris[t as usize];
-                if self.tris[t as usize][0] != DEAD && !tri.contains(&a) && self.flips(t, b, target)
-                {
-                    return Err(Reject::Flip);
-                }
+            if x != w || w == a {
+                continue;
             }
-        }
-        if !self.corners.is_empty() && !self.seam_map(a, b) {
-            return Err(Reject::Topology);
+            while apexes.get(apex).is_some_and(|&x| x < w) {
+                apex += 1;
+            }
+            let dying = apexes[apex..].iter().take_while(|&&x| x == w).count();
+            let (on_aw, on_bw) = (on_aw.len(), on_bw.len());
+            if on_bw == dying {
+                continue;
+            }
+            let refused = if sa.border() {
+                on_aw + on_bw - 2 * dying > self.crowding
+            } else {
+                dying == 0
+            };
+            if refused {
+                return Err(Reject::Topology);
+            }
         }
         Ok(())
     }

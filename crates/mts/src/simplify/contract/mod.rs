@@ -80,7 +80,7 @@ use guards::{border_slots, creased, most_crowded_edge, Reject, Turn};
 use placement::{Endpoint, Optimal, Place};
 
 use super::collapses::{Collapse, Collapses};
-use super::fans::Fans;
+use super::fans::{Fans, Stars, WIDE};
 use super::pairs::virtual_pairs;
 use super::prefetch;
 use super::quadric::{PointSum, Quadric};
@@ -98,8 +98,11 @@ use glam::{DVec3, Vec3};
 /// Runs until no valid pair or no triangle remains (or until
 /// [`SimplifyOptions::stop_at_triangles`]), and says where and why it
 /// stopped in [`Simplification::stop`]. Cost: O((V + T) log T) for
-/// bounded valences; memory under 200 bytes per triangle at peak (197 for
-/// the whole `mts simplify` process on a 1M-triangle icosphere).
+/// bounded valences; where fans hold thousands of triangles over a few
+/// hundred neighbours (a dense non-manifold mesh) O(T log T) and
+/// O(valence) per refused candidate (`fans.rs`, stars); memory under 200
+/// bytes per triangle at peak (197 for the whole `mts simplify` process on
+/// a 1M-triangle icosphere).
 ///
 /// # Panics
 /// If `mesh` breaks the [`Mesh`] invariants (check with
@@ -292,6 +295,9 @@ struct Contractor<P> {
     /// Triangles around each vertex; may hold dead ones until the vertex is
     /// next contracted or chooses again.
     fans: Fans,
+    /// The neighbours of wide fans (`fans.rs`), current until a triangle
+    /// of the fan changes ([`Contractor::contract`] marks them).
+    stars: Stars,
     /// Virtual partners of each vertex (empty unless enabled).
     partners: Vec<Vec<u32>>,
     removed: Vec<bool>,
@@ -448,6 +454,7 @@ impl<P: Place> Contractor<P> {
             tris,
             normals0,
             fans,
+            stars: Stars::new(n),
             partners,
             removed: vec![false; n],
             fan: Vec::new(),
@@ -474,10 +481,15 @@ impl<P: Place> Contractor<P> {
         c
     }
 
-    /// Asks for the triangles around `v` ahead of the loops over them.
+    /// Asks for the triangles around `v` ahead of the loops over them (not
+    /// for a wide fan: its questions go to its star).
     #[inline]
     fn prefetch_ring(&self, v: u32) {
-        for &t in self.fans.get(v) {
+        let around = self.fans.get(v);
+        if around.len() > WIDE {
+            return;
+        }
+        for &t in around {
             prefetch(&self.tris[t as usize]);
         }
     }
@@ -603,6 +615,15 @@ impl<P: Place> Contractor<P> {
         self.partners_into(a, &mut ring);
         if !ring.contains(&b) {
             ring.push(b);
+        }
+        // Every triangle that changes below is around `a` (and in optimal
+        // mode around `b`, whose neighbours are marked once the survivor's
+        // fan is known).
+        if !self.stars.is_empty() {
+            self.stars.invalidate(a);
+            for &w in &ring {
+                self.stars.invalidate(w);
+            }
         }
         let error = P::recorded_error(self, a, target, cost, forward);
         let q = self.quadrics[a as usize] + self.quadrics[b as usize];
@@ -749,6 +770,11 @@ impl<P: Place> Contractor<P> {
         let mut around = std::mem::take(&mut self.around);
         around.clear();
         self.partners_into(survivor, &mut around);
+        if everyone && !self.stars.is_empty() {
+            for &w in &around {
+                self.stars.invalidate(w);
+            }
+        }
         let from_a = ring.len();
         for &w in &around {
             if (everyone || !self.refusals.is_empty(w)) && !ring[..from_a].contains(&w) {
@@ -793,6 +819,7 @@ impl<P: Place> Contractor<P> {
         let c = self.removed.len() as u32;
         self.quadrics.push(Quadric::default());
         self.fans.push_vertex();
+        self.stars.push_vertex();
         self.removed.push(false);
         self.mark.push(0);
         self.queued.push((f32::NAN, NONE));
@@ -903,6 +930,29 @@ mod tests {
             }
         }
         assert!(borders > 10);
+    }
+
+    /// Wide fans (sorted, not scanned) pair as the adjacency does too: a
+    /// dense mesh with a hub, and 40 copies of one triangle beside 25
+    /// reversed ones.
+    #[test]
+    fn border_slots_of_wide_fans_match_the_adjacency() {
+        let mut mesh = dense_with_hub(64, 1000, 3);
+        mesh.triangles.extend([[5, 6, 7]; 40]);
+        mesh.triangles.extend([[5, 7, 6]; 25]);
+        let adjacency = TriangleAdjacency::new(&mesh);
+        let around = Fans::new(mesh.positions.len(), &mesh.triangles);
+        assert!((0..64).all(|v| around.get(v).len() > 32));
+        let slots = border_slots(&mesh.triangles, &around);
+        let mut borders = 0;
+        for (t, (bits, neighbours)) in slots.iter().zip(&adjacency.neighbours).enumerate() {
+            for (slot, &n) in neighbours.iter().enumerate() {
+                let border = n == NO_NEIGHBOUR;
+                assert_eq!(border, bits & (1 << slot) != 0, "{t} {slot}");
+                borders += usize::from(border);
+            }
+        }
+        assert_eq!(borders, 1817);
     }
 
     /// The fan of apex 0 over the ring 1, 2, 3, 4 at `positions`, with
@@ -1093,6 +1143,99 @@ mod tests {
         assert!((c.forward_error(0, 1, 2.3) - own).abs() < 1e-12);
         // Before the apex moved, the same move measured 0's own distance.
         assert!((alone - own).abs() < 1e-12, "{alone}");
+    }
+
+    /// `triangles` distinct random triangles over `vertices` vertices in
+    /// the unit cube (a fixed linear congruential sequence), and a hub:
+    /// both windings of `(0, 1, k)` for every other vertex `k`. Every fan
+    /// is wide and every pair of vertices a common neighbour; the hub's
+    /// crowded edge lets merges pass the fin rule, so about half the
+    /// vertices contract before no valid pair is left.
+    fn dense_with_hub(vertices: u32, triangles: usize, seed: u64) -> Mesh {
+        let mut state = seed;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as u32
+        };
+        let positions = (0..vertices)
+            .map(|_| Vec3::new(next() as f32, next() as f32, next() as f32) / 2f32.powi(31))
+            .collect();
+        let mut seen = std::collections::HashSet::new();
+        let mut tris = Vec::new();
+        while tris.len() < triangles {
+            let t = [next() % vertices, next() % vertices, next() % vertices];
+            let mut key = t;
+            key.sort_unstable();
+            if key[0] != key[1] && key[1] != key[2] && seen.insert(key) {
+                tris.push(t);
+            }
+        }
+        for k in 2..vertices {
+            tris.extend([[0, 1, k], [1, 0, k]]);
+        }
+        Mesh {
+            positions,
+            triangles: tris,
+            properties: Default::default(),
+        }
+    }
+
+    /// Asserts that the stars answer what the scans of the fans answer:
+    /// the topology verdict and the border flag of every pair of live
+    /// vertices, and each vertex's choice as `choose` returns it (scan,
+    /// star). Returns how many pairs pass.
+    fn stars_agree_with_scans<P: Place>(
+        c: &mut Contractor<P>,
+        choose: impl Fn(&mut Contractor<P>, u32) -> (Option<(f64, u32)>, Option<(f64, u32)>),
+    ) -> usize {
+        let live: Vec<u32> = (0..c.removed.len() as u32)
+            .filter(|&v| !c.removed[v as usize])
+            .collect();
+        let mut passed = 0;
+        for &a in &live {
+            let (scan, star) = choose(c, a);
+            assert_eq!(scan, star, "choice of {a}");
+            for &b in live.iter().filter(|&&b| b != a) {
+                let scan = c.topology(a, b).is_ok();
+                let border = c.fan_on_border;
+                let star = c.topology_wide(a, b).is_ok();
+                assert_eq!((scan, border), (star, c.fan_on_border), "{a} -> {b}");
+                passed += usize::from(star);
+            }
+        }
+        passed
+    }
+
+    /// The stars of a dense mesh give the scans' answers as built, partway
+    /// and at the end of the sequence (a star left current across a change
+    /// of its fan would show), in both placements.
+    #[test]
+    fn stars_answer_as_the_scans_do() {
+        let mesh = dense_with_hub(64, 1000, 7);
+        assert_eq!(mesh.triangle_count(), 1124);
+        let mut seen = Vec::new();
+        for stop in [Some(1124), Some(1090), None] {
+            let options = SimplifyOptions {
+                stop_at_triangles: stop,
+                ..Default::default()
+            };
+            let mut c = Contractor::<Endpoint>::new(&mesh, &options);
+            c.run(stop);
+            let passed = stars_agree_with_scans(&mut c, |c, v| {
+                c.refresh(v);
+                let scan = c.best_endpoint(v);
+                (scan, Endpoint::best(c, v))
+            });
+            assert!(!c.stars.is_empty());
+            let mut c_optimal = Contractor::<Optimal>::new(&mesh, &options);
+            c_optimal.run(stop);
+            stars_agree_with_scans(&mut c_optimal, |_, _| (None, None));
+            seen.push((c.steps.len(), passed, c_optimal.steps.len()));
+        }
+        // (endpoint steps, pairs passing the topology rules, optimal steps)
+        assert_eq!(seen, [(0, 2968, 0), (15, 1836, 18), (32, 842, 44)]);
     }
 
     #[test]

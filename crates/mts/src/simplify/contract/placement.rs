@@ -103,7 +103,11 @@ impl Place for Endpoint {
 
     #[inline]
     fn best(c: &mut Contractor<Self>, v: u32) -> Option<(f64, u32)> {
-        c.best_endpoint(v)
+        if c.stars.get(v).is_some() {
+            c.best_endpoint_wide(v)
+        } else {
+            c.best_endpoint(v)
+        }
     }
 
     #[inline]
@@ -178,8 +182,13 @@ impl Place for Optimal {
         let mut around = std::mem::take(&mut c.around);
         around.clear();
         c.partners_into(v, &mut around);
+        let refused = if c.refusals.is_empty(v) {
+            None
+        } else {
+            Some(c.mark_refusals(v))
+        };
         for &w in &around {
-            if c.refusals.contains(v, w) {
+            if refused.is_some_and(|epoch| c.mark[w as usize] == epoch) {
                 continue;
             }
             let cost = Self::pair_cost(c, v, w);
