@@ -377,6 +377,27 @@ fn section(bytes: &[u8], tag: &[u8; 4]) -> usize {
     }
 }
 
+/// The `MODL` section's counts (strips, bands, beginnings, records, far
+/// arcs) and the offset just after them, where the widths are.
+fn modl_counts(file: &[u8]) -> (usize, [usize; 5]) {
+    let mut at = section(file, b"MODL");
+    let mut counts = [0usize; 5];
+    for c in &mut counts {
+        let (mut v, mut shift) = (0usize, 0);
+        loop {
+            let b = file[at];
+            at += 1;
+            v |= usize::from(b & 0x7f) << shift;
+            shift += 7;
+            if b & 0x80 == 0 {
+                break;
+            }
+        }
+        *c = v;
+    }
+    (at, counts)
+}
+
 #[test]
 fn corrupt_files_get_errors_naming_the_place() {
     let good = small_file();
@@ -415,23 +436,7 @@ fn corrupt_files_get_errors_naming_the_place() {
     assert_eq!(place_of(&load_error(&b)), ("STEP", step as u64));
     // The ready model: a width that is neither 2 nor 4, and a record whose
     // arc jumps out of its strip, each named in MODL.
-    let modl = section(&good, b"MODL");
-    let mut at = modl;
-    let mut counts = [0usize; 5];
-    for c in &mut counts {
-        let (mut v, mut shift) = (0usize, 0);
-        loop {
-            let b = good[at];
-            at += 1;
-            v |= usize::from(b & 0x7f) << shift;
-            shift += 7;
-            if b & 0x80 == 0 {
-                break;
-            }
-        }
-        *c = v;
-    }
-    let [strips, bands, begins, records, far] = counts;
+    let (at, [strips, bands, begins, records, far]) = modl_counts(&good);
     let mut b = good.clone();
     b[at] = 3;
     seal(&mut b);
@@ -583,23 +588,7 @@ fn real_models_hold_the_invariant() {
 #[test]
 fn resealed_ready_models_that_lie_are_refused() {
     let good = small_file();
-    let modl = section(&good, b"MODL");
-    let mut at = modl;
-    let mut counts = [0usize; 5];
-    for c in &mut counts {
-        let (mut v, mut shift) = (0usize, 0);
-        loop {
-            let b = good[at];
-            at += 1;
-            v |= usize::from(b & 0x7f) << shift;
-            shift += 7;
-            if b & 0x80 == 0 {
-                break;
-            }
-        }
-        *c = v;
-    }
-    let [strips, bands, begins, records, far] = counts;
+    let (at, [strips, bands, begins, records, far]) = modl_counts(&good);
     let (vw, lw) = (usize::from(good[at]), usize::from(good[at + 1]));
     assert_eq!((vw, lw, far), (2, 2, 0), "the layout this test reads");
     let vertices = at + 2 + 4 * (2 * bands + 1 + 3 * strips + 2 + 2 * begins);
