@@ -398,7 +398,7 @@ impl MeshSource {
                 (name, mesh)
             }
         };
-        let (model, _, _) = build_with_bar(&mesh, &Default::default());
+        let (model, _, _) = build_with_bar(&mesh, &Default::default())?;
         Ok((name, model))
     }
 
@@ -973,7 +973,7 @@ fn build(args: &BuildArgs) -> Result<()> {
              writes such levels)"
         );
     }
-    let (model, _, t) = build_with_bar(&mesh, &options);
+    let (model, _, t) = build_with_bar(&mesh, &options)?;
     let recipe = model.to_recipe_bytes();
     let bytes = if args.recipe_only {
         recipe.clone()
@@ -1051,11 +1051,11 @@ fn build(args: &BuildArgs) -> Result<()> {
 fn build_with_bar(
     mesh: &Mesh,
     options: &mts::model::PipelineOptions,
-) -> (
+) -> mts::Result<(
     mts::MtsModel,
     mts::simplify::Stop,
     mts::model::PipelineTimings,
-) {
+)> {
     use indicatif::{ProgressBar, ProgressStyle};
     let bar = if mesh.triangle_count() >= PROGRESS_MIN_TRIANGLES {
         ProgressBar::new(1)
@@ -1069,7 +1069,7 @@ fn build_with_bar(
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
     bar.set_message("strips + QEM");
     let mut started = false;
-    let out = mts::model::build_from_mesh(mesh, options, &mut |done, max_lod| {
+    let out = mts::model::try_build_from_mesh(mesh, options, &mut |done, max_lod| {
         if !started {
             bar.set_message("graphs (LoDs)");
             bar.set_length(max_lod.max(1) as u64);
@@ -1815,7 +1815,7 @@ fn load_ms_of(method: Method, model: &mts::MtsModel, mesh: &Mesh) -> Result<Opti
 fn compare(args: &CompareArgs) -> Result<()> {
     let (name, mesh, _) = args.source.load()?;
     let t = Instant::now();
-    let (model, _, _) = build_with_bar(&mesh, &Default::default());
+    let (model, _, _) = build_with_bar(&mesh, &Default::default())?;
     let mts_ms = t.elapsed().as_secs_f64() * 1e3;
     let raw = raw_bytes_u16(&mesh);
     let rows = measure_methods(&model, &mesh, mts_ms, args.requests)?;

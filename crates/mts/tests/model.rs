@@ -648,3 +648,23 @@ fn resealed_ready_models_that_lie_are_refused() {
     assert!(vertex[0] * 10 > vertex.iter().sum::<usize>(), "{vertex:?}");
     assert!(entries[0] >= 1, "{entries:?}");
 }
+
+/// The library refuses, as an error, the options the CLI refuses with a
+/// message: optimal placement on a mesh with properties (issue 32).
+#[test]
+fn options_the_model_cannot_hold_are_an_error_not_a_panic() {
+    use mts::model::{try_build_from_mesh, PipelineOptions};
+    let mesh = "torus:300"
+        .parse::<Generated>()
+        .unwrap()
+        .build_with_properties();
+    let mut options = PipelineOptions::default();
+    options.simplify.placement = Placement::Optimal;
+    let e = try_build_from_mesh(&mesh, &options, &mut |_, _| {}).unwrap_err();
+    assert!(matches!(e, mts::Error::InvalidArgument(_)), "{e:?}");
+    assert!(e.to_string().contains("optimal placement"), "{e}");
+    let plain: Mesh = "torus:300".parse::<Generated>().unwrap().build();
+    let (model, _, _) = try_build_from_mesh(&plain, &options, &mut |_, _| {}).unwrap();
+    assert_eq!(model.triangle_count(0), plain.triangle_count());
+    assert!(model.max_lod() > 0);
+}

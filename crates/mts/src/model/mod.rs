@@ -42,7 +42,7 @@ pub use build::{
     MIN_BAND_SLACK,
 };
 pub use extract::{Extractor, Update};
-pub use pipeline::{build_from_mesh, PipelineOptions, PipelineTimings};
+pub use pipeline::{build_from_mesh, try_build_from_mesh, PipelineOptions, PipelineTimings};
 pub use verify::{spread_lods, verify, VerifyReport};
 
 use glam::Vec3;

@@ -2,7 +2,7 @@
 //! contraction sequence (independent of each other, so computed on two
 //! threads), then the per-strip graphs ([`super::build`]).
 
-use super::{build_with_progress, BuildOptions, MtsModel};
+use super::{build_with_progress, can_build, BuildOptions, MtsModel};
 use crate::mesh::Mesh;
 use crate::simplify::{simplify, SimplifyOptions, Stop};
 use crate::strip::{stripify, StripifyOptions};
@@ -43,13 +43,44 @@ pub struct PipelineTimings {
 ///
 /// # Panics
 /// As [`super::build`]: optimal placement on a mesh with properties is
-/// refused ([`super::can_build`]).
+/// refused ([`super::can_build`]); [`try_build_from_mesh`] returns that as
+/// an error instead.
 #[must_use]
 pub fn build_from_mesh(
     mesh: &Mesh,
     options: &PipelineOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> (MtsModel, Stop, PipelineTimings) {
+    match try_build_from_mesh(mesh, options, progress) {
+        Ok(built) => built,
+        Err(e) => panic!("build_from_mesh: {e}"),
+    }
+}
+
+/// [`build_from_mesh`], with the options the model cannot be built from
+/// (optimal placement on a mesh with vertex properties or seams: created
+/// vertices whose counts vary per step, [`super::can_build`]) returned as
+/// an error before any work is done, or after the contraction sequence
+/// when only it tells.
+///
+/// # Errors
+/// [`crate::Error::InvalidArgument`] naming the options.
+pub fn try_build_from_mesh(
+    mesh: &Mesh,
+    options: &PipelineOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> crate::Result<(MtsModel, Stop, PipelineTimings)> {
+    let refused = || {
+        crate::Error::InvalidArgument(
+            "optimal placement creates vertices the MTS model cannot hold on a mesh with \
+             vertex properties or seams: use endpoint placement, or drop the properties"
+                .into(),
+        )
+    };
+    let optimal = options.simplify.placement == crate::simplify::Placement::Optimal;
+    if optimal && !mesh.properties.is_empty() {
+        return Err(refused());
+    }
     let t0 = Instant::now();
     let ((strips, t_strips), (simplification, t_simplify)) = std::thread::scope(|scope| {
         let strips = scope.spawn(|| {
@@ -66,6 +97,9 @@ pub fn build_from_mesh(
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
         (strips, simplified)
     });
+    if !can_build(&simplification.collapses) {
+        return Err(refused());
+    }
     let t1 = Instant::now();
     let model = build_with_progress(
         mesh,
@@ -80,5 +114,5 @@ pub fn build_from_mesh(
         model: t1.elapsed(),
         total: t0.elapsed(),
     };
-    (model, simplification.stop, timings)
+    Ok((model, simplification.stop, timings))
 }
