@@ -18,6 +18,8 @@
 
 #[path = "../../mts/tests/common/mod.rs"]
 mod common;
+// Each test binary uses some of the shared helpers.
+#[allow(dead_code)]
 mod support;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};

@@ -11,6 +11,8 @@
 
 #[path = "../../mts/tests/common/mod.rs"]
 mod common;
+// Each test binary uses some of the shared helpers.
+#[allow(dead_code)]
 mod support;
 
 use mts::mesh::generate::Generated;

@@ -40,7 +40,7 @@
 //! test prints why it is skipped and passes, and fails when `MTS_REQUIRE`
 //! names `gpu`.
 
-// `gpu_on` serves the other tests: this one takes the default adapter.
+// Each test binary uses some of the shared helpers.
 #[allow(dead_code)]
 mod support;
 
@@ -59,7 +59,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
-use support::required_gpu;
+use support::default_gpu as gpu;
 
 /// Operations when `MTS_SOAK_OPS` is unset: about 10 s in release on two
 /// cores with lavapipe (measured: about 0.2 ms an operation, checks and
@@ -176,23 +176,6 @@ fn env_usize(name: &str, default: usize) -> usize {
             .parse()
             .unwrap_or_else(|e| panic!("{name}={v:?} is not a count: {e}")),
         Err(_) => default,
-    }
-}
-
-/// The headless GPU, or `None` with a message when there is none (a
-/// failure when `MTS_REQUIRE` names gpu).
-fn gpu() -> Option<Gpu> {
-    match Gpu::new_headless() {
-        Ok(gpu) => {
-            eprintln!("adapter: {}", gpu.report());
-            Some(gpu)
-        }
-        Err(Error::NoAdapter(why)) => {
-            assert!(!required_gpu(), "MTS_REQUIRE names gpu: no adapter ({why})");
-            eprintln!("skipped: no graphics adapter ({why}); install mesa-vulkan-drivers");
-            None
-        }
-        Err(e) => panic!("GPU setup failed: {e}"),
     }
 }
 

@@ -25,12 +25,16 @@ pub fn is_degenerate(t: [u32; 3]) -> bool {
 /// `(s[i+1], s[i], s[i+2])` for odd `i`; windows with a repeated vertex are
 /// skipped. Cost: O(run), no allocation beyond `out`'s growth.
 pub fn decode_run(run: &[u32], out: &mut Vec<[u32; 3]>) {
-    for (i, w) in run.windows(3).enumerate() {
+    out.extend(run_triangles(run));
+}
+
+/// The oriented triangles of one run, as [`decode_run`] appends them:
+/// the one strip rule, for callers that fold them without a list.
+pub fn run_triangles(run: &[u32]) -> impl Iterator<Item = [u32; 3]> + '_ {
+    run.windows(3).enumerate().filter_map(|(i, w)| {
         let [a, b, c] = [w[0], w[1], w[2]];
-        if !is_degenerate([a, b, c]) {
-            out.push(if i % 2 == 0 { [a, b, c] } else { [b, a, c] });
-        }
-    }
+        (!is_degenerate([a, b, c])).then_some(if i % 2 == 0 { [a, b, c] } else { [b, a, c] })
+    })
 }
 
 /// Appends the oriented triangles of a buffer of runs joined by

@@ -27,3 +27,20 @@ pub fn gpu_on(backends: wgpu::Backends, what: &str) -> Option<Gpu> {
         Err(e) => panic!("{what} setup failed: {e}"),
     }
 }
+
+/// The default headless GPU (any backend), or `None` with a message (a
+/// failure when `MTS_REQUIRE` names gpu).
+pub fn default_gpu() -> Option<Gpu> {
+    match Gpu::new_headless() {
+        Ok(gpu) => {
+            eprintln!("adapter: {}", gpu.report());
+            Some(gpu)
+        }
+        Err(Error::NoAdapter(why)) => {
+            assert!(!required_gpu(), "MTS_REQUIRE names gpu: no adapter ({why})");
+            eprintln!("skipped: no graphics adapter ({why}); install mesa-vulkan-drivers");
+            None
+        }
+        Err(e) => panic!("GPU setup failed: {e}"),
+    }
+}

@@ -37,7 +37,7 @@
 //! the recipe.
 
 use super::MtsModel;
-use crate::encoding::{is_degenerate, RESTART_U32};
+use crate::encoding::{is_degenerate, run_triangles, RESTART_U32};
 use crate::strip::canonical_triangle;
 
 /// A keyed hash of oriented triangles, and the multiset digest built on it.
@@ -106,23 +106,14 @@ impl TriangleKey {
     pub(crate) fn digest_of_runs(&self, buffer: &[u32]) -> Digest {
         let mut d = Digest::default();
         for run in buffer.split(|&i| i == RESTART_U32) {
-            for (i, w) in run.windows(3).enumerate() {
-                let t = if i % 2 == 0 {
-                    [w[0], w[1], w[2]]
-                } else {
-                    [w[1], w[0], w[2]]
-                };
-                if !is_degenerate(t) {
-                    d.sum = d.sum.wrapping_add(self.hash(t));
-                    d.count += 1;
-                }
+            for t in run_triangles(run) {
+                d.sum = d.sum.wrapping_add(self.hash(t));
+                d.count += 1;
             }
         }
         d
     }
-}
 
-impl TriangleKey {
     /// The LoDs loading compares, per band of `bands` (each band's first
     /// LoD): LoD 0, and one drawn with the key from all of `1..=max_lod`
     /// (so a band is drawn in proportion to its LoDs).
