@@ -2569,8 +2569,8 @@ def gen_fifo(rng, seeds, index, quick=False):
         else:
             case.files.append(("m.mtl", b"newmtl skin\nmap_Kd tex.png\n"))
             case.files.append(("tex.png", ("fifo",)))
-        # Without --properties the .mtl is not read at all.
-        case.run(["convert", "{in}", "-o", "{out}.obj"], ACCEPT, names=["{in}", "m.mtl", "tex.png"], **short)
+        # With --positions-only the .mtl is not read at all.
+        case.run(["convert", "{in}", "--positions-only", "-o", "{out}.obj"], ACCEPT, names=["{in}", "m.mtl", "tex.png"], **short)
         out = rng.choice([".obj", ".glb", ".ply"])
         case.run(["convert", "{in}", "--properties", "-o", "{out}" + out], UNKNOWN, names=["{in}", "m.mtl", "tex.png"],
                  **short)
@@ -3119,7 +3119,7 @@ def gen_props(rng, seeds, index, quick=False):
         with_props = expect == ACCEPT or rng.random() < 0.7
         case = Case("props", "weights:%s %s%s" % (flag, v, "" if with_props else ",no-properties"), ".obj",
                     obj_text_props(pos, tris))
-        argv = ["simplify", "{in}"] + (["--properties"] if with_props else []) + \
+        argv = ["simplify", "{in}"] + (["--properties"] if with_props else ["--positions-only"]) + \
                ["--ratio", "0.5", "--samples", "300", "--no-meshopt"] + arg
         case.run(argv, expect, target=False)
         return case

@@ -6,9 +6,12 @@
 #   ... change, rebuild ...
 #   scripts/output-hashes.sh target/release/mts > after.txt; diff before.txt after.txt
 # One line per (input, command): the sha256 of its output; a last line hashes
-# them all.
+# them all. Meshes are read positions only (`--positions-only`, the flag of
+# the commands since properties became the default); a binary from before
+# that needs POSITIONS_ONLY= (empty) to compare with.
 set -uo pipefail
 mts=${1:-target/release/mts}
+read -r -a pos <<< "${POSITIONS_ONLY---positions-only}"
 models=${MODELS:-$(dirname "$0")/../../shared/models}
 work=$(mktemp -d)
 export WORK=$work
@@ -43,15 +46,15 @@ for m in "$models"/*.obj "$models"/*.ply; do [ -f "$m" ] && inputs+=("$m"); done
 gens=(icosphere:20k torus:5k grid:2k)
 for src in "${inputs[@]}" "${gens[@]}"; do
   if [ -f "$src" ]; then arg=("$src"); n=$(basename "$src"); else arg=(--generated "$src"); n=$src; fi
-  run "$n strips" "$mts" strips "${arg[@]}" --json --repeat 1
-  run "$n simplify" "$mts" simplify "${arg[@]}" --ratio 0.1 --samples 2000 --json -o "$work/s.obj"
+  run "$n strips" "$mts" strips "${arg[@]}" "${pos[@]}" --json --repeat 1
+  run "$n simplify" "$mts" simplify "${arg[@]}" "${pos[@]}" --ratio 0.1 --samples 2000 --json -o "$work/s.obj"
   file_hash "$n simplify.obj" "$work/s.obj"
-  run "$n build" "$mts" build "${arg[@]}" -o "$work/m.mts" --json
+  run "$n build" "$mts" build "${arg[@]}" "${pos[@]}" -o "$work/m.mts" --json
   file_hash "$n build.mts" "$work/m.mts"
   run "$n extract" "$mts" extract "$work/m.mts" --ratio 0.1 --repeat 1 --json -o "$work/e.obj"
   file_hash "$n extract.obj" "$work/e.obj"
   run "$n verify" "$mts" verify "$work/m.mts" --lods 40 --json
-  run "$n encode" "$mts" encode "${arg[@]}" -o "$work/c.stream" --json
+  run "$n encode" "$mts" encode "${arg[@]}" "${pos[@]}" -o "$work/c.stream" --json
   file_hash "$n encode.stream" "$work/c.stream"
   rm -f "$work"/*
 done | tee "$work/../hashes.$$"

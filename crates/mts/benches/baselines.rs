@@ -8,7 +8,7 @@ mod common;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use mts::methods::Method;
-use mts::model::{build_from_mesh, sequence, PipelineOptions};
+use mts::model::{build_from_mesh, requests, PipelineOptions};
 use mts::LodSource;
 use std::hint::black_box;
 
@@ -36,7 +36,7 @@ fn bench(c: &mut Criterion) {
             let counts: Vec<u32> = (0..=max_lod)
                 .map(|l| source.triangle_count(l) as u32)
                 .collect();
-            let (_, lods) = sequence::table2(&counts, REQUESTS)
+            let (_, lods) = requests::table2(&counts, REQUESTS)
                 .into_iter()
                 .find(|(name, _)| *name == seq)
                 .expect("a Table 2 sequence");

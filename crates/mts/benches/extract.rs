@@ -1,7 +1,7 @@
 //! Criterion: LoD extraction on the bunny (or a generated 70K icosphere when
 //! `../shared/models` is absent), the MTS paper's Table 2: the linear,
 //! exponential and random request sequences (1,000 requests each, see
-//! `mts::model::sequence`), with the coherence cache and from scratch, side
+//! `mts::model::requests`), with the coherence cache and from scratch, side
 //! by side in one group; plus LoD 0 from scratch and 1,000 consecutive LoDs
 //! (a step of one, the "linear sweep over all LoDs" case). Throughput is
 //! per LoD change. A second group: one-step changes near LoD 0 on the
@@ -11,7 +11,7 @@
 mod common;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use mts::model::{build_from_mesh, sequence, PipelineOptions};
+use mts::model::{build_from_mesh, requests, PipelineOptions};
 use mts::Extractor;
 use std::hint::black_box;
 
@@ -22,7 +22,7 @@ fn bench(c: &mut Criterion) {
     let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
     let max_lod = model.max_lod();
     let start = max_lod / 4;
-    let [linear, exponential, random] = sequence::table2(model.triangle_counts(), REQUESTS);
+    let [linear, exponential, random] = requests::table2(model.triangle_counts(), REQUESTS);
     let sequences = [
         linear,
         exponential,

@@ -14,11 +14,11 @@
 //! Run with `cargo run --release -p mts --features peers --example
 //! property_error [-- [--models DIR] [--uv-weight W] [--normal-weight W]]`;
 //! the models default to `../shared/models`, the weights to
-//! `AttributeWeights::default()`.
+//! `MESHOPT_WEIGHTS`.
 
 use mts::distance::{property_error, surface_distance, Stat, DEFAULT_SAMPLES};
 use mts::mesh::io::{load, LoadOptions};
-use mts::peers::meshopt::{refusal, simplify_with_attributes_to_lod, AttributeWeights};
+use mts::peers::meshopt::{refusal, simplify_with_attributes_to_lod, MESHOPT_WEIGHTS};
 use mts::{Mesh, SimplifyOptions};
 use std::path::PathBuf;
 
@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut ours = SimplifyOptions::default();
     let mut samples = DEFAULT_SAMPLES;
     let mut dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
-    let mut weights = AttributeWeights::default();
+    let mut weights = MESHOPT_WEIGHTS;
     let mut args = std::env::args().skip(1);
     while let Some(flag) = args.next() {
         let value = args.next().ok_or(usage)?;

@@ -1,12 +1,11 @@
 //! [`LodSource`]: the one interface over MTS and the baselines, so that the
 //! benchmarks, the CLI and the renderer treat every method alike.
 //!
-//! Every source answers the LoD numbering of `../shared/DESIGN.md` (LoD 0
+//! Every source answers the LoD numbering of `docs/design.md` (LoD 0
 //! is the full mesh, LoD `k` the mesh after `k` contractions of its own
 //! sequence), keeps one index buffer that a LoD change rewrites in place,
 //! and reports which parts it rewrote.
 
-use crate::model::Extractor;
 use glam::Vec3;
 use std::ops::Range;
 
@@ -92,60 +91,4 @@ pub fn lod_for_triangles(source: &dyn LodSource, budget: usize) -> usize {
         }
     }
     lo
-}
-
-impl LodSource for Extractor<'_> {
-    fn name(&self) -> &'static str {
-        "mts"
-    }
-
-    fn max_lod(&self) -> usize {
-        self.model().max_lod()
-    }
-
-    fn triangle_count(&self, lod: usize) -> usize {
-        self.model().triangle_count(lod.min(self.model().max_lod()))
-    }
-
-    fn positions(&self) -> &[Vec3] {
-        self.model().positions()
-    }
-
-    fn properties(&self) -> &crate::mesh::Properties {
-        self.model().properties()
-    }
-
-    fn topology(&self) -> Topology {
-        Topology::StripRestart
-    }
-
-    /// The coherent walk of [`Extractor::set_lod`].
-    fn set_lod(&mut self, lod: usize) -> usize {
-        Extractor::set_lod(self, lod).lod
-    }
-
-    fn lod(&self) -> Option<usize> {
-        Extractor::lod(self)
-    }
-
-    fn indices(&self) -> &[u32] {
-        self.buffer()
-    }
-
-    fn dirty_ranges(&self) -> &[Range<usize>] {
-        Extractor::dirty_ranges(self)
-    }
-
-    fn memory_bytes(&self) -> usize {
-        self.model().stats().memory_bytes + Extractor::memory_bytes(self)
-    }
-
-    /// Serializes the model (O(model)).
-    fn file_bytes(&self) -> usize {
-        self.model().to_bytes().len()
-    }
-
-    fn triangles(&self) -> Vec<[u32; 3]> {
-        Extractor::triangles(self)
-    }
 }

@@ -9,7 +9,7 @@ use common::{model, random_surface};
 use mts::baselines::cluster::stream;
 use mts::baselines::{ClusterTree, DiscreteLods, MultilevelMesh, ProgressiveMesh};
 use mts::mesh::generate::Generated;
-use mts::model::sequence;
+use mts::model::requests;
 use mts::strip::sorted_canonical;
 use mts::{Collapses, Extractor, LodSource, Mesh, StripifyOptions};
 use proptest::prelude::*;
@@ -68,7 +68,7 @@ fn check_against_oracle(mesh: &Mesh, c: &Collapses, source: &mut dyn LodSource, 
 fn orders(max_lod: usize) -> Vec<Vec<usize>> {
     let down: Vec<usize> = (0..=max_lod).collect();
     let up: Vec<usize> = (0..=max_lod).rev().collect();
-    let random = sequence::random(max_lod, 200, 7);
+    let random = requests::random(max_lod, 200, 7);
     let jumps: Vec<usize> = (0..20)
         .map(|i| if i % 2 == 0 { max_lod } else { i % 5 })
         .collect();
@@ -148,7 +148,7 @@ fn switching_gives_the_same_buffer_as_from_scratch() {
     let c = collapses(&mesh);
     let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
     let mut ml = MultilevelMesh::new(&mesh, &c).unwrap();
-    for lod in sequence::random(c.max_lod(), 100, 3) {
+    for lod in requests::random(c.max_lod(), 100, 3) {
         pm.set_lod(lod);
         ml.set_lod(lod);
         let mut fresh_pm = ProgressiveMesh::new(&mesh, &c).unwrap();
@@ -434,7 +434,7 @@ fn bunny_spread_lods_match_the_oracle_and_mts() {
     // Down, then back up, then jumps.
     let up: Vec<usize> = lods.iter().rev().copied().collect();
     lods.extend(up);
-    lods.extend(sequence::random(c.max_lod(), 10, 11));
+    lods.extend(requests::random(c.max_lod(), 10, 11));
     for &lod in &lods {
         LodSource::set_lod(&mut ex, lod);
         pm.set_lod(lod);
@@ -490,7 +490,7 @@ proptest! {
         pm.validate().unwrap();
         ml.validate().unwrap();
         let mut lods: Vec<usize> = (0..=c.max_lod()).collect();
-        lods.extend(sequence::random(c.max_lod(), 20, 5));
+        lods.extend(requests::random(c.max_lod(), 20, 5));
         check_against_oracle(&mesh, &c, &mut pm, &lods);
         check_against_oracle(&mesh, &c, &mut ml, &lods);
         let back = ProgressiveMesh::from_bytes(&pm.to_bytes(), "random.pm").unwrap();
@@ -501,7 +501,7 @@ proptest! {
     fn random_meshes_cluster_tree(mesh in random_surface()) {
         let tree = ClusterTree::new(&mesh).unwrap();
         let c = tree.collapses().clone();
-        let lods: Vec<usize> = (0..=c.max_lod()).rev().chain(sequence::random(c.max_lod(), 20, 9)).collect();
+        let lods: Vec<usize> = (0..=c.max_lod()).rev().chain(requests::random(c.max_lod(), 20, 9)).collect();
         check_against_oracle(&mesh, &c, &mut tree.clone(), &lods);
         let bytes = tree.to_stream();
         let d = stream::decode(&bytes, "random.stream").unwrap();

@@ -55,7 +55,7 @@ fn a_coarse_lod_of_spot_has_bounded_uv_error() {
 mod peers {
     use super::*;
     use mts::peers::meshopt::{
-        simplify, simplify_with_attributes, simplify_with_attributes_to_lod, AttributeWeights,
+        simplify, simplify_with_attributes, simplify_with_attributes_to_lod, MESHOPT_WEIGHTS,
     };
 
     #[test]
@@ -65,7 +65,7 @@ mod peers {
         };
         let target = mesh.triangle_count() / 10;
         assert_eq!(
-            simplify_with_attributes(&mesh, target, AttributeWeights::default()),
+            simplify_with_attributes(&mesh, target, MESHOPT_WEIGHTS),
             simplify(&mesh, target)
         );
     }
@@ -78,9 +78,9 @@ mod peers {
         let c = super::simplify(&mesh, &SimplifyOptions::default()).collapses;
         let lod = c.lod_for_ratio(0.1);
         let uv_rms = |uv: f32| {
-            let weights = AttributeWeights {
+            let weights = mts::simplify::AttributeWeights {
                 uv,
-                ..AttributeWeights::default()
+                ..MESHOPT_WEIGHTS
             };
             let (theirs, at) = simplify_with_attributes_to_lod(&mesh, &c, lod, weights);
             // The LoD to compare with has at most their count.
@@ -91,7 +91,7 @@ mod peers {
             };
             property_error(&mesh, &theirs, 50_000).uv.unwrap().rms
         };
-        let (blind, weighted) = (uv_rms(0.0), uv_rms(AttributeWeights::default().uv));
+        let (blind, weighted) = (uv_rms(0.0), uv_rms(MESHOPT_WEIGHTS.uv));
         assert!(weighted < 0.9 * blind, "{weighted} against {blind}");
     }
 }

@@ -199,7 +199,8 @@ fn ordered_list_work(m: &Mesh) -> (f64, f64) {
 
 /// Invocations per triangle of the strips' restart buffer in batches of 96.
 fn strip_batch96(s: &Strips) -> f64 {
-    use mts::strip::vertex_work::{vertex_work, CacheModel, Topology};
+    use mts::strip::vertex_work::{vertex_work, CacheModel};
+    use mts::Topology;
     vertex_work(
         &s.to_restart_u32(),
         Topology::StripRestart,

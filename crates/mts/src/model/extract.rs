@@ -47,6 +47,34 @@ pub struct Update {
 ///
 /// Allocation happens in [`Extractor::new`] only: every buffer is sized for
 /// the worst case there.
+///
+/// # Example
+///
+/// ```
+/// use mts::mesh::generate::Generated;
+/// use mts::model::{build_from_mesh, PipelineOptions};
+/// use mts::strip::sorted_canonical;
+/// use mts::Extractor;
+///
+/// let mesh = "torus:2k".parse::<Generated>()?.build();
+/// let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
+/// let mut extractor = Extractor::new(&model);
+/// let half = extractor.set_ratio(0.5).lod;
+/// // The strips draw exactly the replayed contraction sequence's triangles.
+/// let replayed = model.collapses().triangles_at(&model.mesh(), half);
+/// assert_eq!(sorted_canonical(&extractor.triangles()), sorted_canonical(&replayed));
+/// // One contraction more: only the strips it changed are walked again, and
+/// // only the index ranges they rewrote are to be uploaded.
+/// let step = extractor.set_lod(half + 1);
+/// assert!(step.strips_walked < model.strip_count());
+/// let dirty: usize = extractor.dirty_ranges().iter().map(|r| r.len()).sum();
+/// assert!(dirty < extractor.active_range().len());
+/// // The same bytes as a walk from scratch.
+/// let mut scratch = Extractor::new(&model);
+/// scratch.set_lod_from_scratch(half + 1);
+/// assert_eq!(extractor.buffer(), scratch.buffer());
+/// # Ok::<(), mts::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Extractor<'m> {
     model: &'m MtsModel,
@@ -532,4 +560,62 @@ fn walk_records<V: Word, L: Word>(
     }
     w.len = len as u32;
     w
+}
+
+/// MTS as one of the [`LodSource`](crate::lod::LodSource)s the CLI, the benches and the renderer
+/// treat alike.
+impl crate::lod::LodSource for Extractor<'_> {
+    fn name(&self) -> &'static str {
+        "mts"
+    }
+
+    fn max_lod(&self) -> usize {
+        self.model().max_lod()
+    }
+
+    fn triangle_count(&self, lod: usize) -> usize {
+        self.model().triangle_count(lod.min(self.model().max_lod()))
+    }
+
+    fn positions(&self) -> &[glam::Vec3] {
+        self.model().positions()
+    }
+
+    fn properties(&self) -> &crate::mesh::Properties {
+        self.model().properties()
+    }
+
+    fn topology(&self) -> crate::lod::Topology {
+        crate::lod::Topology::StripRestart
+    }
+
+    /// The coherent walk of [`Extractor::set_lod`].
+    fn set_lod(&mut self, lod: usize) -> usize {
+        Extractor::set_lod(self, lod).lod
+    }
+
+    fn lod(&self) -> Option<usize> {
+        Extractor::lod(self)
+    }
+
+    fn indices(&self) -> &[u32] {
+        self.buffer()
+    }
+
+    fn dirty_ranges(&self) -> &[Range<usize>] {
+        Extractor::dirty_ranges(self)
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.model().stats().memory_bytes + Extractor::memory_bytes(self)
+    }
+
+    /// Serializes the model (O(model)).
+    fn file_bytes(&self) -> usize {
+        self.model().to_bytes().len()
+    }
+
+    fn triangles(&self) -> Vec<[u32; 3]> {
+        Extractor::triangles(self)
+    }
 }

@@ -34,7 +34,7 @@ pub mod format;
 mod pipeline;
 pub(crate) mod records;
 mod segments;
-pub mod sequence;
+pub mod requests;
 mod verify;
 
 pub use build::{

@@ -1,6 +1,7 @@
 //! meshoptimizer (through the `meshopt` crate) as the reference stripifier.
 
 use crate::mesh::Mesh;
+use crate::simplify::AttributeWeights;
 use crate::simplify::Collapses;
 use crate::strip::encode::RESTART_U32;
 use crate::strip::Strips;
@@ -109,9 +110,9 @@ pub fn simplify_to_lod(mesh: &Mesh, collapses: &Collapses, lod: usize) -> (Vec<[
     (theirs, lod)
 }
 
-/// Weights of the property streams in meshoptimizer's
-/// `simplifyWithAttributes`, one per stream (each float of the stream gets
-/// it).
+/// The weights ([`AttributeWeights`], one per stream: each float of the
+/// stream gets it) this peer gives meshoptimizer's `simplifyWithAttributes`
+/// by default. Its scale is not [`crate::simplify`]'s:
 ///
 /// meshoptimizer scales positions into the unit cube (by the largest
 /// extent) and adds each triangle's attribute error, weighted by its area,
@@ -120,33 +121,20 @@ pub fn simplify_to_lod(mesh: &Mesh, collapses: &Collapses, lod: usize) -> (Vec<[
 /// README recommends about 1 for normalised attributes (unit normals,
 /// colours in 0..=1) and, for texture coordinates, 10 to 100 depending on
 /// their density, or `1/sqrt(average UV area of a triangle)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AttributeWeights {
-    /// Weight of each normal component (unit normals).
-    pub normal: f32,
-    /// Weight of each texture coordinate (UV units).
-    pub uv: f32,
-    /// Weight of each colour channel (0..=1).
-    pub color: f32,
-}
-
-impl Default for AttributeWeights {
-    /// Normals and colours 1, as meshoptimizer's README recommends for
-    /// normalised attributes; texture coordinates 30, the middle (on a log
-    /// scale) of its 10 to 100. Its density rule gives 109 on spot.obj and
-    /// 84 on pirate.obj. Over the four textured rows of
-    /// `examples/property_error.rs` (spot and pirate at 10% and 1%) the
-    /// mean UV RMS of meshoptimizer's LoDs was 0.188 at weight 10, 0.177
-    /// at 30 and 0.185 at 100 (`--uv-weight`); a normal weight of 0.5 or 2
-    /// against 1 moved beetle's normal RMS at 10% by under 0.5°.
-    fn default() -> AttributeWeights {
-        AttributeWeights {
-            normal: 1.0,
-            uv: 30.0,
-            color: 1.0,
-        }
-    }
-}
+///
+/// Normals and colours 1, as meshoptimizer's README recommends for
+/// normalised attributes; texture coordinates 30, the middle (on a log
+/// scale) of its 10 to 100. Its density rule gives 109 on spot.obj and
+/// 84 on pirate.obj. Over the four textured rows of
+/// `examples/property_error.rs` (spot and pirate at 10% and 1%) the
+/// mean UV RMS of meshoptimizer's LoDs was 0.188 at weight 10, 0.177
+/// at 30 and 0.185 at 100 (`--uv-weight`); a normal weight of 0.5 or 2
+/// against 1 moved beetle's normal RMS at 10% by under 0.5°.
+pub const MESHOPT_WEIGHTS: AttributeWeights = AttributeWeights {
+    normal: 1.0,
+    uv: 30.0,
+    color: 1.0,
+};
 
 /// meshoptimizer's `simplifyWithAttributes` toward `target_triangles`, with
 /// the normals, texture coordinates and colours `mesh` has as attributes

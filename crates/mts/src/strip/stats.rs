@@ -1,7 +1,8 @@
 //! Figures of merit for a set of strips.
 
-use super::vertex_work::{vertex_work, CacheModel, Topology};
+use super::vertex_work::{vertex_work, CacheModel};
 use super::Strips;
+use crate::lod::Topology;
 
 /// What `mts strips` reports for one stripifier.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -25,16 +25,7 @@
 //! their vertices are shaded too.
 
 use super::encode::RESTART_U32;
-
-/// How the index buffer is assembled into triangles.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Topology {
-    /// Three indices per triangle (a trailing partial triangle is ignored).
-    List,
-    /// Triangle strips joined by [`RESTART_U32`] (a stitched buffer is the
-    /// same without restart values).
-    StripRestart,
-}
+use crate::lod::Topology;
 
 /// A post-transform cache model; the number is its size (entries, or
 /// indices per batch).
@@ -77,7 +68,7 @@ pub fn list_fifo16_batch96(triangles: &[[u32; 3]], vertex_count: usize) -> (f64,
     let flat: Vec<u32> = triangles.iter().flatten().copied().collect();
     (
         super::acmr::fifo_acmr(triangles, vertex_count, super::acmr::CACHE_SIZE),
-        vertex_work(&flat, Topology::List, CacheModel::Batch(96)).per_triangle(),
+        vertex_work(&flat, Topology::TriangleList, CacheModel::Batch(96)).per_triangle(),
     )
 }
 
@@ -109,7 +100,11 @@ impl VertexWork {
 /// the triangle's last index, its three vertices), degenerate windows
 /// included. Cost: O(indices), no allocation.
 fn windows(indices: &[u32], topology: Topology) -> impl Iterator<Item = (usize, [u32; 3])> + '_ {
-    let step = if topology == Topology::List { 3 } else { 1 };
+    let step = if topology == Topology::TriangleList {
+        3
+    } else {
+        1
+    };
     (0..indices.len().saturating_sub(2))
         .step_by(step)
         .map(move |i| (i + 2, [indices[i], indices[i + 1], indices[i + 2]]))
@@ -137,7 +132,7 @@ pub fn vertex_work(indices: &[u32], topology: Topology, model: CacheModel) -> Ve
         .filter(|(_, [a, b, c])| a != b && b != c && a != c)
         .count() as u64;
     let used = match topology {
-        Topology::List => &indices[..indices.len() / 3 * 3],
+        Topology::TriangleList => &indices[..indices.len() / 3 * 3],
         Topology::StripRestart => indices,
     };
     let vertex_count = used
@@ -239,7 +234,7 @@ mod tests {
         //   1---3---5
         let list = [0, 1, 2, 2, 1, 3, 2, 3, 4, 4, 3, 5];
         // Batch 6: {0,1,2,3} then {2,3,4,5}: 8. One batch of 12: 6.
-        let w = vertex_work(&list, Topology::List, CacheModel::Batch(6));
+        let w = vertex_work(&list, Topology::TriangleList, CacheModel::Batch(6));
         assert_eq!(
             w,
             VertexWork {
@@ -249,16 +244,16 @@ mod tests {
             }
         );
         assert_eq!(
-            vertex_work(&list, Topology::List, CacheModel::Batch(12)).invocations,
+            vertex_work(&list, Topology::TriangleList, CacheModel::Batch(12)).invocations,
             6
         );
         // FIFO 16 and LRU 32 hold all six vertices.
         assert_eq!(
-            vertex_work(&list, Topology::List, CacheModel::Fifo(16)).invocations,
+            vertex_work(&list, Topology::TriangleList, CacheModel::Fifo(16)).invocations,
             6
         );
         assert_eq!(
-            vertex_work(&list, Topology::List, CacheModel::Lru(32)).invocations,
+            vertex_work(&list, Topology::TriangleList, CacheModel::Lru(32)).invocations,
             6
         );
         assert_eq!(w.per_triangle(), 2.0);
@@ -354,7 +349,7 @@ mod tests {
         fn invocations_lie_between_distinct_vertices_and_references(
             (s, list) in stream(), n in 1u32..64,
         ) {
-            let topology = if list { Topology::List } else { Topology::StripRestart };
+            let topology = if list { Topology::TriangleList } else { Topology::StripRestart };
             // The vertices of the assembled windows, and how often they are
             // referenced by the buffer.
             let mut distinct: Vec<u32> =
@@ -402,7 +397,7 @@ mod tests {
             t in prop::collection::vec([0u32..30, 0u32..30, 0u32..30], 1..100),
         ) {
             let flat: Vec<u32> = t.iter().flatten().copied().collect();
-            let w = vertex_work(&flat, Topology::List, CacheModel::Fifo(16));
+            let w = vertex_work(&flat, Topology::TriangleList, CacheModel::Fifo(16));
             let acmr = super::super::acmr::fifo_acmr(&t, 30, 16);
             let misses = (acmr * t.len() as f64).round() as u64;
             prop_assert_eq!(w.invocations, misses);

@@ -178,34 +178,13 @@ impl Decoded {
         self.positions.len() == self.total_vertices && self.triangles.len() == self.total_triangles
     }
 
-    /// The decoded mesh with vertices no triangle uses yet dropped (order
-    /// kept), with their properties, so that it passes [`Mesh::validate`].
+    /// The decoded mesh with vertices no triangle uses yet dropped
+    /// (renumbered in first use, [`Mesh::level`]), with their properties,
+    /// so that it passes [`Mesh::validate`].
     /// O(V + T).
     #[must_use]
     pub fn mesh(&self) -> Mesh {
-        let mut map = vec![u32::MAX; self.positions.len()];
-        let mut positions = Vec::new();
-        let mut order = Vec::new();
-        let triangles = self
-            .triangles
-            .iter()
-            .map(|t| {
-                t.map(|v| {
-                    let slot = &mut map[v as usize];
-                    if *slot == u32::MAX {
-                        *slot = positions.len() as u32;
-                        positions.push(self.positions[v as usize]);
-                        order.push(v);
-                    }
-                    *slot
-                })
-            })
-            .collect();
-        Mesh {
-            positions,
-            triangles,
-            properties: self.properties.gather(&order),
-        }
+        Mesh::level(&self.positions, &self.triangles, &self.properties)
     }
 }
 

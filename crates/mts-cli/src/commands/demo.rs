@@ -6,9 +6,25 @@
 
 use crate::stdout::outln;
 use anyhow::Result;
-use mts::model::{build_from_mesh, sequence, PipelineOptions};
+use mts::model::{build_from_mesh, requests, PipelineOptions};
 use mts::Extractor;
+use std::path::PathBuf;
 use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct DemoArgs {
+    #[command(flatten)]
+    pub source: crate::args::MeshSource,
+    /// Where the strip of thumbnails (PNG) goes.
+    #[arg(long, default_value = "demo-thumbnails.png")]
+    pub thumbnails: PathBuf,
+}
+
+/// `mts demo`: the demo on the command's mesh.
+pub fn run(args: &DemoArgs) -> Result<()> {
+    let (name, mesh, _) = args.source.load_for_scene()?;
+    demo(&name, &mesh, &args.thumbnails)
+}
 
 /// Shares of the triangles shown as thumbnails, left to right.
 const THUMBNAIL_SHARES: [f64; 5] = [1.0, 0.25, 0.05, 0.01, 0.002];
@@ -17,7 +33,7 @@ const THUMBNAIL: u32 = 256;
 
 /// Runs the demo on `mesh` (named `name`), prints its summary and writes
 /// the thumbnails to `thumbnails` (when the renderer is built in).
-pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result<()> {
+pub fn demo(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result<()> {
     outln!(
         "{name}: {} triangles, {} vertices",
         mesh.triangle_count(),
@@ -43,7 +59,7 @@ pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result
     )?;
     // A sweep from the coarsest LoD to the full mesh, one LoD at a time
     // over a window, as a viewer zooming in would ask for them.
-    let lods = sequence::linear(model.max_lod(), model.max_lod() + 1);
+    let lods = requests::linear(model.max_lod(), model.max_lod() + 1);
     let mut ex = Extractor::new(&model);
     let t0 = Instant::now();
     let mut walked = 0;
@@ -63,7 +79,7 @@ pub fn run(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Result
         walked as f64 / lods.len() as f64,
         scratch / coherent
     )?;
-    let levels = super::bench::measure_levels(&model);
+    let levels = crate::bench::measure::measure_levels(&model);
     outln!()?;
     outln!(
         "{:>6} {:>9} {:>12} {:>12} {:>14} {:>10} {:>12}",

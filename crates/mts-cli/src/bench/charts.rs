@@ -1,7 +1,7 @@
 //! PNG charts of `mts bench`'s results (plotters, bitmap backend, DejaVu
 //! Sans embedded so no system font is needed).
 
-use crate::results::{Figure6Row, Level, Model, Results, ScaleRow};
+use crate::bench::results::{Figure6Row, Level, Model, Results, ScaleRow};
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};

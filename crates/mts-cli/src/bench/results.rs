@@ -9,6 +9,13 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
+/// Version of `results.json`'s layout (`docs/bench-schema.md`).
+pub const SCHEMA_VERSION: u32 = 6;
+
+/// Steps (of 255) an RGB byte may move before an image comparison
+/// (Figure 6's, the scene's, the properties') counts the pixel as changed.
+pub const IMAGE_TOLERANCE: u8 = 8;
+
 /// The whole file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -364,7 +371,7 @@ pub struct Scene {
     pub compared_frames: u64,
     pub differing_pixel_share: Option<f64>,
     /// The same, counting only pixels whose colour moved by more than
-    /// [`crate::figure6::IMAGE_TOLERANCE`] of 255 in a channel.
+    /// [`crate::bench::results::IMAGE_TOLERANCE`] of 255 in a channel.
     pub visibly_differing_pixel_share: Option<f64>,
     /// The same, counting only pixels covered by instances in one image
     /// and not the other (silhouettes that moved).
@@ -456,12 +463,12 @@ impl Results {
         let mut de = serde_json::Deserializer::from_str(&text);
         let results: Results = serde_path_to_error::deserialize(&mut de)
             .map_err(|e| anyhow::anyhow!("{}: at `{}`: {}", path.display(), e.path(), e.inner()))?;
-        if results.schema != crate::bench::SCHEMA_VERSION {
+        if results.schema != SCHEMA_VERSION {
             anyhow::bail!(
                 "{}: schema {} where this build reads {} (run mts bench again)",
                 path.display(),
                 results.schema,
-                crate::bench::SCHEMA_VERSION
+                SCHEMA_VERSION
             );
         }
         Ok(results)

@@ -5,7 +5,7 @@
 //! indices than the list at every level, and Figure 6 and the scene ran
 //! wherever an adapter was found.
 
-use crate::results::{FastSimplificationRun, MethodRow, Results};
+use crate::bench::results::{FastSimplificationRun, MethodRow, Results};
 use mts::methods::{Method, SHARES};
 
 /// The broken invariants of `r`, each naming its model and section (empty

@@ -23,7 +23,7 @@
 //! cost `e` ms and drawing cost `d` ms, a second holds `1 + (1000 − e) / d`
 //! frames.
 
-use crate::results::{Figure6, Figure6Row, Scene};
+use crate::bench::results::{Figure6, Figure6Row, Scene};
 use anyhow::Result;
 use mts::{peers, Extractor, MtsModel};
 use mts_render::headless::HeadlessTarget;
@@ -34,9 +34,7 @@ use std::time::Instant;
 const WIDTH: u32 = 800;
 const HEIGHT: u32 = 600;
 
-/// Steps (of 255) an RGB byte may move before
-/// [`Renderer::image_differences`] counts the pixel as changed.
-pub const IMAGE_TOLERANCE: u8 = 8;
+use super::results::IMAGE_TOLERANCE;
 
 /// The renderer state shared by every model of a run.
 pub struct Renderer {
@@ -241,10 +239,10 @@ impl Renderer {
             }
         }
         for method in [
-            super::Method::Pm,
-            super::Method::Multilevel,
-            super::Method::Cluster,
-            super::Method::Discrete,
+            mts::methods::Method::Pm,
+            mts::methods::Method::Multilevel,
+            mts::methods::Method::Cluster,
+            mts::methods::Method::Discrete,
         ] {
             self.measure_source(method, model, input, shares, frames, &camera, &mut rows)?;
         }
@@ -260,14 +258,14 @@ impl Renderer {
     /// framed as Figure 6 frames it.
     ///
     /// # Errors
-    /// As [`super::bench_render::measure_vertex_work`].
+    /// As [`super::vertex_work::measure_vertex_work`].
     pub fn measure_vertex_work(
         &self,
         name: &str,
         model: &MtsModel,
-    ) -> Result<crate::results::VertexWork> {
+    ) -> Result<crate::bench::results::VertexWork> {
         let camera = Camera::framing_points(model.positions(), self.target.aspect());
-        super::bench_render::measure_vertex_work(
+        super::vertex_work::measure_vertex_work(
             &self.gpu,
             &self.target,
             &self.config,
@@ -280,20 +278,20 @@ impl Renderer {
     /// Scene rows (see `mts bench render --scene`) of `models`.
     ///
     /// # Errors
-    /// As [`super::bench_render::scene_rows`].
+    /// As [`super::scene::scene_rows`].
     pub fn measure_scene(
         &self,
         models: &[(String, &MtsModel)],
-        spec: &super::bench_render::SceneSpec<'_>,
+        spec: &super::scene::SceneSpec<'_>,
     ) -> Result<Vec<Scene>> {
-        super::bench_render::scene_rows(&self.gpu, &self.target, &self.config, models, spec)
+        super::scene::scene_rows(&self.gpu, &self.target, &self.config, models, spec)
     }
 
     /// Figure 6 rows of one baseline (see the module documentation).
     #[allow(clippy::too_many_arguments)]
     fn measure_source(
         &self,
-        method: super::Method,
+        method: mts::methods::Method,
         model: &MtsModel,
         input: &mts::Mesh,
         shares: &[f64],
@@ -302,7 +300,7 @@ impl Renderer {
         rows: &mut Vec<Figure6Row>,
     ) -> Result<()> {
         let (d, q) = (&self.gpu.device, &self.gpu.queue);
-        let mut source = super::make_source(method, model, input)?;
+        let mut source = method.source(model, input)?;
         let mut renderer = StripRenderer::for_source(d, q, &self.config, source.as_mut())?;
         renderer.set_camera(q, camera);
         let median = |mut v: Vec<f64>| {

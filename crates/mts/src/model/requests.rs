@@ -1,4 +1,4 @@
-//! The LoD request sequences of the MTS paper's Table 2 (section 5.2):
+//! Request sequences: the LoD requests of the MTS paper's Table 2 (section 5.2):
 //! linear, exponential and random. The paper does not define them beyond
 //! their names; these definitions are ours, shared by the benches, `mts
 //! bench` and the baselines so every method sees the same requests.

@@ -6,8 +6,8 @@
 //! `--readme` rewrites it there, `--check` fails when it differs from what
 //! the data gives (a test runs that on the committed report).
 
-use super::bench::{figure6_row, machine_words, scale_table, strips_table};
-use crate::results::{FastSimplificationRun, MethodRow, Model, Results, ScaleRow};
+use super::report::{figure6_row, machine_words, scale_table, strips_table};
+use crate::bench::results::{FastSimplificationRun, MethodRow, Model, Results, ScaleRow};
 use std::fmt::Write as _;
 
 /// First line of the generated section in the README.
@@ -46,7 +46,7 @@ fn yes(met: Option<bool>) -> &'static str {
 }
 
 /// The measured methods of a model (skipped ones left out).
-fn measured(m: &Model) -> impl Iterator<Item = &crate::results::Method> {
+fn measured(m: &Model) -> impl Iterator<Item = &crate::bench::results::Method> {
     m.methods.iter().filter_map(|x| match x {
         MethodRow::Measured(x) => Some(x),
         MethodRow::Skipped { .. } => None,
@@ -138,7 +138,7 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
         let n = files.len();
         let verdicts: Vec<(bool, bool, bool)> = files
             .iter()
-            .map(|m| crate::bench::cache_aware_verdict(m))
+            .map(|m| super::report::cache_aware_verdict(m))
             .collect();
         let count = |f: fn(&(bool, bool, bool)) -> bool| verdicts.iter().filter(|v| f(v)).count();
         let (i, f, b) = (count(|v| v.0), count(|v| v.1), count(|v| v.2));

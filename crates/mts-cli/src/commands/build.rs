@@ -1,0 +1,200 @@
+//! `mts build`: build the MTS model and write it as an `.mts` file.
+
+use crate::args::*;
+use crate::stdout::outln;
+use anyhow::{bail, Result};
+use clap::Args;
+use mts::mesh::Mesh;
+use mts::StripifyOptions;
+use serde_json::json;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct BuildArgs {
+    #[command(flatten)]
+    pub source: MeshSource,
+    /// The .mts file to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Start a new band of strips when they send this much more indices per
+    /// triangle than at the band's start (see BuildOptions::band_slack).
+    #[arg(allow_negative_numbers = true, long, default_value_t = mts::model::DEFAULT_BAND_SLACK,
+          value_parser = band_slack)]
+    pub band_slack: f64,
+    /// One band only: the paper's model, whose strips degrade as the mesh
+    /// is simplified.
+    #[arg(long, conflicts_with = "band_slack")]
+    pub single_band: bool,
+    /// Optimal placement in the contraction sequence (new vertices).
+    #[arg(long)]
+    pub optimal: bool,
+    /// Cache-aware strips for LoD 0 and every band (see
+    /// StripifyOptions::cache_aware).
+    #[arg(long)]
+    pub cache_aware: bool,
+    /// Write the recipe only (strips, contraction sequence, options; the
+    /// file format's version 1 or 2): about a seventh of the ready file,
+    /// but loading builds the graphs again (hundreds of milliseconds
+    /// instead of a few).
+    #[arg(long)]
+    pub recipe_only: bool,
+}
+
+impl BuildArgs {
+    fn pipeline_options(&self) -> mts::model::PipelineOptions {
+        use mts::simplify::{Placement, SimplifyOptions};
+        let bands = mts::model::BuildOptions::default().stripify;
+        mts::model::PipelineOptions {
+            stripify: StripifyOptions {
+                cache_aware: self.cache_aware,
+                ..StripifyOptions::default()
+            },
+            simplify: SimplifyOptions {
+                placement: if self.optimal {
+                    Placement::Optimal
+                } else {
+                    Placement::Endpoint
+                },
+                ..SimplifyOptions::default()
+            },
+            build: mts::model::BuildOptions {
+                band_slack: if self.single_band {
+                    f64::INFINITY
+                } else {
+                    self.band_slack
+                },
+                stripify: StripifyOptions {
+                    cache_aware: self.cache_aware,
+                    ..bands
+                },
+            },
+        }
+    }
+}
+
+pub fn run(args: &BuildArgs) -> Result<()> {
+    args.source.check_output(&args.output)?;
+    let started = std::time::Instant::now();
+    let (name, mesh, _) = args.source.load()?;
+    let load = started.elapsed();
+    let options = args.pipeline_options();
+    if args.optimal && !mesh.properties.is_empty() {
+        bail!(
+            "{name}: the MTS model cannot hold the vertices optimal placement creates with \
+             properties; drop --optimal, or add --positions-only (`mts simplify --optimal` \
+             writes such levels with their properties)"
+        );
+    }
+    let (model, _, t) = build_with_bar(&mesh, &options)?;
+    let recipe = model.to_recipe_bytes();
+    let bytes = if args.recipe_only {
+        recipe.clone()
+    } else {
+        model.to_bytes()
+    };
+    mts::output::write_file(&args.output, &bytes)?;
+    let st = model.stats();
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    if args.json {
+        outln!(
+            "{}",
+            json!({
+                "input": name,
+                "vertices": mesh.vertex_count(),
+                "triangles": mesh.triangle_count(),
+                "max_lod": model.max_lod(),
+                "strips": st.strips,
+                "bytes": bytes.len(),
+                "recipe_bytes": recipe.len(),
+                "raw_bytes": model.raw_bytes(),
+                "bands": model.band_count(),
+                "nodes": st.nodes,
+                "arcs": st.arcs,
+                "memory_bytes": st.memory_bytes,
+                "ms_load": ms(load),
+                "ms_stripify": ms(t.stripify),
+                "ms_simplify": ms(t.simplify),
+                "ms_model": ms(t.model),
+                "ms": ms(t.total),
+            })
+        )?;
+    } else {
+        outln!(
+            "{name}: {} triangles, {} vertices, {} LoDs",
+            mesh.triangle_count(),
+            mesh.vertex_count(),
+            model.max_lod() + 1
+        )?;
+        outln!(
+            "  time      load {:.1} ms; stripify {:.1} ms beside simplify {:.1} ms, model {:.1} ms, total {:.1} ms",
+            ms(load),
+            ms(t.stripify),
+            ms(t.simplify),
+            ms(t.model),
+            ms(t.total)
+        )?;
+        outln!(
+            "  model     {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
+            model.band_count(),
+            st.strips,
+            st.nodes,
+            st.arcs,
+            st.memory_bytes as f64 / 1e6
+        )?;
+        outln!(
+            "  file      {} bytes = {:.2} x raw ({} bytes: 12 per vertex and its properties, 12 per triangle) -> {}",
+            bytes.len(),
+            bytes.len() as f64 / model.raw_bytes() as f64,
+            model.raw_bytes(),
+            args.output.display()
+        )?;
+        if !args.recipe_only {
+            outln!(
+                "            of which the recipe {} bytes = {:.2} x raw (what --recipe-only writes)",
+                recipe.len(),
+                recipe.len() as f64 / model.raw_bytes() as f64
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// Inputs of this many triangles or more get a progress bar.
+const PROGRESS_MIN_TRIANGLES: usize = 200_000;
+
+/// The whole pipeline with a progress bar on large inputs.
+pub fn build_with_bar(
+    mesh: &Mesh,
+    options: &mts::model::PipelineOptions,
+) -> mts::Result<(
+    mts::MtsModel,
+    mts::simplify::Stop,
+    mts::model::PipelineTimings,
+)> {
+    use indicatif::{ProgressBar, ProgressStyle};
+    let bar = if mesh.triangle_count() >= PROGRESS_MIN_TRIANGLES {
+        ProgressBar::new(1)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg:16} [{bar:30}] {pos}/{len} {elapsed}")
+            .expect("valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar.set_message("strips + QEM");
+    let mut started = false;
+    let out = mts::model::try_build_from_mesh(mesh, options, &mut |done, max_lod| {
+        if !started {
+            bar.set_message("graphs (LoDs)");
+            bar.set_length(max_lod.max(1) as u64);
+            started = true;
+        }
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    out
+}

@@ -1,0 +1,157 @@
+//! `mts extract`: one LoD of a model, by MTS or a baseline.
+
+use crate::args::*;
+use crate::stdout::outln;
+use anyhow::{Context, Result};
+use clap::Args;
+use mts::mesh::Mesh;
+use mts::methods::Method;
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Args)]
+pub struct ExtractArgs {
+    #[command(flatten)]
+    pub source: MeshSource,
+    #[command(flatten)]
+    pub level: LevelArgs,
+    /// Write the extracted triangles (.obj, .ply, .glb or .gltf, by extension).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Timed extractions from scratch (1 to 10,000); the median is reported.
+    #[arg(long, default_value_t = 11, value_parser = count_in::<1, MAX_REPEAT>, allow_negative_numbers = true)]
+    pub repeat: usize,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// The method extracting the LoD: mts (strips) or a baseline. The
+    /// cluster tree has its own clustering, so its LoD k differs; use
+    /// --triangles or --ratio to compare methods.
+    #[arg(long, value_parser = method_parser(), default_value = "mts")]
+    pub method: Method,
+}
+
+pub fn run(args: &ExtractArgs) -> Result<()> {
+    use mts::Extractor;
+    if let Some(out) = &args.output {
+        args.source.check_output(out)?;
+    }
+    if args.method != Method::Mts {
+        return extract_baseline(args);
+    }
+    let started = Instant::now();
+    let (name, model) = args.source.model()?;
+    // Opening, validating (and, today, rebuilding the graphs from the
+    // file's recipe), until an extractor is ready.
+    let ready = Extractor::new(&model);
+    let load_ms = started.elapsed().as_secs_f64() * 1e3;
+    drop(ready);
+    let lod = args
+        .level
+        .resolve_model(&model)?
+        .context("give --lod, --triangles or --ratio")?;
+    // Each timed extraction starts from an empty extractor (no coherence).
+    let mut times = Vec::with_capacity(args.repeat.max(1));
+    let mut ex = Extractor::new(&model);
+    for _ in 0..args.repeat.max(1) {
+        ex = Extractor::new(&model);
+        let t = Instant::now();
+        ex.set_lod(lod);
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    times.sort_by(f64::total_cmp);
+    let us = times[times.len() / 2];
+    let mut compact = Vec::new();
+    ex.write_compact(&mut compact);
+    let runs = compact
+        .split(|&i| i == mts::strip::encode::RESTART_U32)
+        .filter(|r| !r.is_empty())
+        .count();
+    let triangles = model.triangle_count(lod);
+    let mut vertices_written = None;
+    if let Some(out) = &args.output {
+        // The level's own vertices only, renumbered; their properties are
+        // the input vertices' (a model with properties has no created
+        // vertices: endpoint placement).
+        let mesh = Mesh::level(model.positions(), &ex.triangles(), model.properties());
+        super::save_mesh(&mesh, out)?;
+        vertices_written = Some(mesh.vertex_count());
+    }
+    if args.json {
+        let mut v = json!({
+            "input": name,
+            "lod": lod,
+            "max_lod": model.max_lod(),
+            "triangles": triangles,
+            "strips": runs,
+            "indices": ex.indices_sent(),
+            "indices_per_triangle": ex.indices_sent() as f64 / triangles.max(1) as f64,
+            "us": us,
+            "load_ms": load_ms,
+        });
+        if let Some(n) = vertices_written {
+            v["vertices_written"] = json!(n);
+        }
+        outln!("{v}")?;
+    } else {
+        outln!(
+            "{name}: LoD {lod} of {}: {triangles} triangles in {runs} strips, {} indices sent ({:.3} per triangle), extracted in {us:.1} us (median of {} from scratch)",
+            model.max_lod(),
+            ex.indices_sent(),
+            ex.indices_sent() as f64 / triangles.max(1) as f64,
+            times.len()
+        )?;
+    }
+    Ok(())
+}
+
+fn extract_baseline(args: &ExtractArgs) -> Result<()> {
+    let (name, model) = args.source.model()?;
+    let mesh = model.mesh();
+    let mut source = args.method.source(&model, &mesh)?;
+    let lod = args
+        .level
+        .resolve(source.as_ref())?
+        .context("give --lod, --triangles or --ratio")?;
+    // Each timed change starts from a fresh source (no coherence).
+    let mut times = Vec::with_capacity(args.repeat.max(1));
+    for _ in 0..args.repeat.max(1) {
+        source = args.method.source(&model, &mesh)?;
+        let t = Instant::now();
+        source.set_lod(lod);
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    times.sort_by(f64::total_cmp);
+    let us = times[times.len() / 2];
+    let triangles = source.triangles();
+    if let Some(out) = &args.output {
+        let m = Mesh::level(&mesh.positions, &triangles, &mesh.properties);
+        super::save_mesh(&m, out)?;
+    }
+    let method = source.name();
+    if args.json {
+        outln!(
+            "{}",
+            json!({
+                "input": name,
+                "method": method,
+                "lod": lod,
+                "max_lod": source.max_lod(),
+                "triangles": triangles.len(),
+                "indices": source.indices().len(),
+                "indices_per_triangle": source.indices().len() as f64 / triangles.len().max(1) as f64,
+                "us": us,
+            })
+        )?;
+    } else {
+        outln!(
+            "{name}: {method} LoD {lod} of {}: {} triangles, {} indices sent, set in {us:.1} us (median of {} from a fresh source)",
+            source.max_lod(),
+            triangles.len(),
+            source.indices().len(),
+            times.len()
+        )?;
+    }
+    Ok(())
+}

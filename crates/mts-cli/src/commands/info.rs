@@ -1,0 +1,144 @@
+//! `mts info`: describe an `.mts` file.
+
+use crate::stdout::outln;
+use anyhow::{Context, Result};
+use clap::Args;
+use mts::{stripify, StripifyOptions};
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Args)]
+pub struct InfoArgs {
+    /// The .mts file.
+    pub model: PathBuf,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: &InfoArgs) -> Result<()> {
+    use mts::{Extractor, MtsModel};
+    let t0 = Instant::now();
+    let model = MtsModel::load(&args.model)?;
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let file_bytes = std::fs::metadata(&args.model)
+        .with_context(|| format!("cannot read {}", args.model.display()))?
+        .len();
+    let st = model.stats();
+    let mesh = model.mesh();
+    let mut ex = Extractor::new(&model);
+    let mut levels = Vec::new();
+    for ratio in [1.0, 0.5, 0.25, 0.1, 0.05, 0.01] {
+        let lod = model.lod_for_ratio(ratio);
+        ex.set_lod(lod);
+        let triangles = model.triangle_count(lod);
+        let fresh = stripify(
+            &model.collapses().mesh_at(&mesh, lod),
+            &StripifyOptions::default(),
+        );
+        let ours = ex.indices_sent() as f64 / triangles.max(1) as f64;
+        let theirs = fresh.restart_index_count() as f64 / triangles.max(1) as f64;
+        levels.push(json!({
+            "ratio": ratio,
+            "lod": lod,
+            "triangles": triangles,
+            "indices": ex.indices_sent(),
+            "indices_per_triangle": ours,
+            "restripified_indices_per_triangle": theirs,
+            "quality_ratio": ours / theirs,
+        }));
+    }
+    let props = model.properties();
+    let mut streams = Vec::new();
+    for (present, name) in [
+        (props.normals.is_some(), "normals"),
+        (props.uvs.is_some(), "uvs"),
+        (props.colors.is_some(), "colors"),
+    ] {
+        if present {
+            streams.push(name);
+        }
+    }
+    let points = props
+        .position_ids
+        .iter()
+        .max()
+        .map_or(model.collapses().vertex_count(), |&m| m as usize + 1);
+    let texture = props.texture.as_ref().map(|t| match t {
+        mts::mesh::Texture::File(f) => f.display().to_string(),
+        mts::mesh::Texture::Embedded { mime, bytes } => {
+            format!("embedded {mime} ({} bytes)", bytes.len())
+        }
+    });
+    if args.json {
+        let mut v = json!({
+            "file": args.model.display().to_string(),
+            "file_bytes": file_bytes,
+                "raw_bytes": model.raw_bytes(),
+                "load_ms": load_ms,
+                "vertices": model.positions().len(),
+                "triangles": model.triangle_count(0),
+                "max_lod": model.max_lod(),
+                "bands": model.band_count(),
+                "strips": st.strips,
+                "nodes": st.nodes,
+                "arcs": st.arcs,
+            "memory_bytes": st.memory_bytes,
+            "levels": levels,
+        });
+        // Only for a model with properties, so that the output of the
+        // others stays as it was.
+        if !props.is_empty() {
+            v["properties"] = json!({
+                "streams": streams,
+                "points": points,
+                "texture": texture,
+            });
+        }
+        outln!("{}", serde_json::to_string_pretty(&v)?)?;
+    } else {
+        outln!(
+            "{}: {} bytes ({:.2} x raw), loaded and built in {load_ms:.1} ms",
+            args.model.display(),
+            file_bytes,
+            file_bytes as f64 / model.raw_bytes() as f64
+        )?;
+        outln!("  {} vertices, {} triangles, {} LoDs, {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
+            model.positions().len(), model.triangle_count(0), model.max_lod() + 1, model.band_count(), st.strips, st.nodes, st.arcs, st.memory_bytes as f64 / 1e6)?;
+        if !props.is_empty() {
+            outln!(
+                "  properties: {} on {points} points; texture: {}",
+                if streams.is_empty() {
+                    "none".to_string()
+                } else {
+                    streams.join(", ")
+                },
+                texture.as_deref().unwrap_or("none")
+            )?;
+        }
+        outln!(
+            "  {:>6} {:>7} {:>9} {:>9} {:>11} {:>7}",
+            "share",
+            "LoD",
+            "triangles",
+            "idx/tri",
+            "restripify",
+            "ratio"
+        )?;
+        for l in &levels {
+            outln!(
+                "  {:>5.0}% {:>7} {:>9} {:>9.3} {:>11.3} {:>7.3}",
+                l["ratio"].as_f64().unwrap_or(0.0) * 100.0,
+                l["lod"].as_u64().unwrap_or(0),
+                l["triangles"].as_u64().unwrap_or(0),
+                l["indices_per_triangle"].as_f64().unwrap_or(0.0),
+                l["restripified_indices_per_triangle"]
+                    .as_f64()
+                    .unwrap_or(0.0),
+                l["quality_ratio"].as_f64().unwrap_or(0.0),
+            )?;
+        }
+    }
+    Ok(())
+}
