@@ -791,3 +791,19 @@ fn growth_exponent(points: &[(f64, f64)]) -> Option<f64> {
     });
     (den > 0.0).then(|| num / den)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn growth_exponent_recovers_a_power_law() {
+        let points: Vec<(f64, f64)> = [1e4, 1e5, 1e6]
+            .iter()
+            .map(|&x: &f64| (x.ln(), (3.0 * x.powf(1.25)).ln()))
+            .collect();
+        let k = growth_exponent(&points).unwrap();
+        assert!((k - 1.25).abs() < 1e-9, "{k}");
+        assert_eq!(growth_exponent(&points[..1]), None);
+    }
+}
