@@ -1,4 +1,4 @@
-//! The strip encoding of `../shared/DESIGN.md` ("Strip encoding"): how a
+//! The strip encoding of `docs/design.md` ("Strip encoding"): how a
 //! run of vertices or a restart-joined index buffer draws triangles.
 //!
 //! A leaf: it imports nothing from the crate, so every layer reads strips

@@ -1,13 +1,15 @@
 //! # mts — continuous level of detail with multiresolution triangle strips
 //!
 //! A mesh is loaded ([`mesh::io`]) or generated ([`mesh::generate`]), cut
-//! into generalized triangle strips ([`stripify`], a STRIPE-style hybrid
-//! search) and simplified into one contraction sequence ([`simplify`]);
+//! into generalized triangle strips ([`stripify()`], a STRIPE-style hybrid
+//! search) and simplified into one contraction sequence ([`simplify()`]);
 //! from both, [`model::build`] makes the multiresolution model
 //! ([`MtsModel`]) whose [`Extractor`] emits strips for any LoD, re-walking
-//! only the strips that changed. See `ARCHITECTURE.md` and
-//! `../shared/DESIGN.md`. The wgpu renderer is the crate `mts-render`; this
-//! crate has no GPU, no CLI and, by default, no C++ peer (feature `peers`:
+//! only the strips that changed. The design (data flow, LoD numbering, the
+//! invariant every test leans on, the strip encoding) is `docs/design.md`
+//! in the repository; where the code is and why, `ARCHITECTURE.md`. The
+//! wgpu renderer is the crate `mts-render`; this crate has no GPU, no CLI
+//! and, by default, no C++ peer (feature `peers`:
 //! meshoptimizer, and the discrete-LoD baseline made from it) and no glTF
 //! (feature `gltf`: [`mesh::io`] reads and writes `.gltf`/`.glb`). The methods
 //! MTS is measured against ([`baselines`]: progressive mesh,

@@ -64,7 +64,7 @@ impl Method {
     /// # Errors
     /// What the baseline's constructor returns; for the discrete LoDs, an
     /// [`crate::Error::InvalidArgument`] when meshoptimizer would take quadratic
-    /// time on `mesh` ([`crate::peers::meshopt::refusal`]).
+    /// time on `mesh` (`peers::meshopt::refusal`, feature `peers`).
     ///
     /// Cost: the method's construction (MTS: O(strips)).
     pub fn source<'m>(self, model: &'m MtsModel, mesh: &Mesh) -> Result<Box<dyn LodSource + 'm>> {

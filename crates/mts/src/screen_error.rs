@@ -106,6 +106,32 @@ pub fn nearest_distance(eye: Vec3, centre: Vec3, radius: f32) -> f32 {
 /// error is allowed, or the input is not understood: full detail is the
 /// safe answer). With 0 pixels per unit (nothing visible) the coarsest
 /// LoD. O(log LoDs).
+///
+/// # Example
+///
+/// ```
+/// use mts::mesh::generate::Generated;
+/// use mts::{lod_for_screen_error, simplify, Projection, SimplifyOptions};
+///
+/// let mesh = "torus:4k".parse::<Generated>()?.build();
+/// let collapses = simplify(&mesh, &SimplifyOptions::default()).collapses;
+/// let camera = Projection::Perspective { fov_y: 60f32.to_radians(), viewport_height: 1080.0 };
+/// // At most one pixel of error, the instance at scale 1 seen from `distance`.
+/// let lod_at = |distance: f32| {
+///     let pixels_per_unit = camera.pixels_per_unit(distance);
+///     lod_for_screen_error(&collapses, mesh.diagonal(), 1.0, pixels_per_unit, 1.0)
+/// };
+/// let (near, far) = (lod_at(2.0), lod_at(200.0));
+/// assert!(near < far && far <= collapses.max_lod());
+/// let pixels = |lod: usize, distance: f32| {
+///     f64::from(collapses.error(lod))
+///         * f64::from(mesh.diagonal())
+///         * f64::from(camera.pixels_per_unit(distance))
+/// };
+/// // The coarsest LoD within the threshold: one more contraction exceeds it.
+/// assert!(pixels(near, 2.0) <= 1.0 && pixels(near + 1, 2.0) > 1.0);
+/// # Ok::<(), mts::Error>(())
+/// ```
 #[must_use]
 pub fn lod_for_screen_error(
     collapses: &Collapses,
@@ -132,8 +158,9 @@ pub fn lod_for_screen_error(
 
 /// [`lod_for_screen_error`] for any [`LodSource`] built from `collapses`:
 /// every source numbers its LoDs by the contractions of the sequence it
-/// was built from (`../shared/DESIGN.md`), so the sequence's error table
-/// answers for it too; the LoD is clamped to the source's `max_lod`.
+/// was built from (`docs/design.md`, "Level-of-detail numbering"), so the
+/// sequence's error table answers for it too; the LoD is clamped to the
+/// source's `max_lod`.
 /// Discrete LoDs draw the coarsest stored level with at least the LoD's
 /// triangle count, simplified by meshoptimizer: at least as many
 /// triangles, with meshoptimizer's error rather than the sequence's.

@@ -6,8 +6,8 @@
 //! `--readme` rewrites it there, `--check` fails when it differs from what
 //! the data gives (a test runs that on the committed report).
 
-use super::report::{figure6_row, machine_words, scale_table, strips_table};
-use crate::bench::results::{FastSimplificationRun, MethodRow, Model, Results, ScaleRow};
+use super::report::{figure6_row, machine_words};
+use crate::bench::results::{MethodRow, Model, Results, ScaleRow};
 use std::fmt::Write as _;
 
 /// First line of the generated section in the README.
@@ -69,16 +69,19 @@ pub fn summary(results: &Results, report_dir: &str) -> String {
         results.command,
     );
     targets(&mut s, results, models);
-    strips(&mut s, models);
+    // The per-model tables (strips, simplification, its peers) and the
+    // scale rows stay in the report: the README keeps the targets and the
+    // focus model.
+    let _ = writeln!(
+        s,
+        "Per model ({} in this run): strips, simplification against meshoptimizer (and fast-simplification where it ran) and the scale rows are tables of [the report]({report_dir}/report.md).\n",
+        models.len()
+    );
     if let Some(b) = focus(models) {
         levels(&mut s, b, models);
-    }
-    quality(&mut s, results, models);
-    if let Some(b) = focus(models) {
         methods(&mut s, b, models);
         render(&mut s, results, b);
     }
-    scale(&mut s, results);
     // The charts `mts bench` draws from the same data.
     let mut charts = Vec::new();
     if let Some(b) = focus(models) {
@@ -90,8 +93,12 @@ pub fn summary(results: &Results, report_dir: &str) -> String {
     if results.scale.is_some() {
         charts.push("scale");
     }
-    for chart in charts {
-        let _ = writeln!(s, "![{chart}]({report_dir}/{chart}.png)\n");
+    let images: Vec<String> = charts
+        .iter()
+        .map(|chart| format!("![{chart}]({report_dir}/{chart}.png)"))
+        .collect();
+    if !images.is_empty() {
+        let _ = writeln!(s, "{}\n", images.join(" "));
     }
     let _ = writeln!(s, "{END}");
     s
@@ -418,12 +425,6 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
     let _ = writeln!(s);
 }
 
-fn strips(s: &mut String, models: &[Model]) {
-    let _ = writeln!(s, "### Strips against meshoptimizer\n");
-    strips_table(s, models);
-    let _ = writeln!(s);
-}
-
 fn levels(s: &mut String, b: &Model, models: &[Model]) {
     let _ = writeln!(s, "### Indices sent per level ({})\n", b.name);
     let _ = writeln!(s, "MTS strips extracted at each level, the level's triangle list, and meshoptimizer's strips of the level's mesh stripified afresh:\n");
@@ -464,62 +465,6 @@ fn levels(s: &mut String, b: &Model, models: &[Model]) {
         );
     }
     let _ = writeln!(s);
-}
-
-fn quality(s: &mut String, results: &Results, models: &[Model]) {
-    let _ = writeln!(s, "### Simplification against meshoptimizer\n");
-    let _ = writeln!(s, "Hausdorff distance to the input (relative to the bounding-box diagonal) of the project's LoD and of meshoptimizer's `simplify` asked for the same triangle count (where it stops above it, the project's LoD is taken at its count), as mts / meshoptimizer (ratio); the milliseconds of the project's whole sequence (every LoD) against meshoptimizer's `simplify` to 10%.\n");
-    let _ = writeln!(
-        s,
-        "| model | Hausdorff at 10% | Hausdorff at 1% | ms whole sequence / meshopt to 10% |"
-    );
-    let _ = writeln!(s, "|---|---|---|---|");
-    for m in models {
-        let mut row = format!("| {} |", m.name);
-        for q in &m.quality {
-            let (a, b) = (q.mts.hausdorff, q.meshopt.hausdorff);
-            let ratio = if a == 0.0 && b == 0.0 { 1.0 } else { a / b };
-            let bold = if ratio > 1.15 { "**" } else { "" };
-            let _ = write!(row, " {a:.5} / {b:.5} ({bold}{ratio:.2}{bold}) |");
-        }
-        let _ = writeln!(
-            s,
-            "{row} {:.0} / {:.0} |",
-            m.simplify.ms, m.simplify.meshopt_ms_to_10
-        );
-    }
-    let _ = writeln!(s);
-    if let Some(FastSimplificationRun::Rows(peer)) = &results.fast_simplification {
-        let _ = writeln!(s, "fast-simplification (`crates/mts-cli/peers/fast_simplification.py`, error measured by `mts distance`), Hausdorff at 10% / 1% against the project's:");
-        let _ = writeln!(s);
-        let _ = writeln!(
-            s,
-            "| model | fast-simplification | mts | fast-simplification ms to 10% |"
-        );
-        let _ = writeln!(s, "|---|---|---|---|");
-        for m in models {
-            let find = |share: f64| peer.iter().find(|p| p.mesh == m.name && p.ratio == share);
-            let ours = |share: f64| {
-                m.quality
-                    .iter()
-                    .find(|q| q.share == share)
-                    .map_or(f64::NAN, |q| q.mts.hausdorff)
-            };
-            if let (Some(a), Some(b)) = (find(0.1), find(0.01)) {
-                let _ = writeln!(
-                    s,
-                    "| {} | {:.5} / {:.5} | {:.5} / {:.5} | {:.0} |",
-                    m.name,
-                    a.hausdorff,
-                    b.hausdorff,
-                    ours(0.1),
-                    ours(0.01),
-                    a.ms,
-                );
-            }
-        }
-        let _ = writeln!(s);
-    }
 }
 
 fn methods(s: &mut String, b: &Model, models: &[Model]) {
@@ -618,14 +563,6 @@ fn render(s: &mut String, results: &Results, b: &Model) {
         let _ = writeln!(s, "\nScene: {} instances of {} models, LoD by screen-space error (1 px) from buffers shared per LoD bucket, culled by the instance BVH, along a fly-through: {:.0} visible, {:.0} triangles ({:.1}% of full detail), update {:.2} ms median ({:.2} ms p99), frame {:.2} ms; {} CPU bytes per instance, GPU {:.2} × the full-detail strips; {} of the covered pixels differ from full detail.", scene.instances, scene.models, scene.visible, scene.triangles_drawn, 100.0 * scene.triangles_drawn / scene.triangles_full_detail.max(1.0), scene.update_ms_median, scene.update_ms_p99, scene.frame_ms_median, scene.cpu_bytes_per_instance, scene.gpu_bytes as f64 / scene.full_detail_strip_bytes.max(1) as f64, scene.differing_pixel_share.map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)));
     }
     let _ = writeln!(s);
-}
-
-fn scale(s: &mut String, results: &Results) {
-    if let Some(scale) = &results.scale {
-        let _ = writeln!(s, "### Scale (generated icospheres)\n");
-        scale_table(s, scale);
-        let _ = writeln!(s);
-    }
 }
 
 /// `readme` with its generated section replaced by `section`; `None`

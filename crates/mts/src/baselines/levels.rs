@@ -5,7 +5,7 @@
 //! After the progressive multilevel meshes paper (section "Progressive
 //! multilevel mesh"): vertices and triangles are enumerated in order of
 //! decreasing level, so every LoD is a prefix of both arrays. Here every
-//! contraction is its own level (the LoD numbering of `../shared/DESIGN.md`
+//! contraction is its own level (the LoD numbering of `docs/design.md`
 //! needs one level per step): the vertices step `i` moves (its removed
 //! vertex, then its companions on a mesh with seams, in
 //! [`Collapses::moves`] order) get the consecutive indices

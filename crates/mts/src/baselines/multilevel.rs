@@ -1,7 +1,6 @@
-//! Progressive multilevel mesh after Gueziec, Taubin, Horn and Lazarus,
-//! "A framework for streaming geometry in VRML" / "Progressive multilevel
-//! meshes" (`../shared/papers/progressive-multilevel-meshes.txt`), sections
-//! "Vertex representatives", "Progressive multilevel mesh", "Low memory
+//! Progressive multilevel mesh after Guéziec, Taubin, Horn and Lazarus,
+//! "A framework for streaming geometry in VRML" (IEEE Computer Graphics
+//! and Applications, 1999), sections "Vertex representatives", "Progressive multilevel mesh", "Low memory
 //! footprint" and "Geomorphs".
 //!
 //! Vertices and triangles are sorted by level (`baselines/levels.rs`: one level

@@ -5,7 +5,7 @@
 //! built from (the LoD-0 strips, the contraction sequence, the build
 //! options), so loading meant building again: about half a second for the
 //! bunny. Version 3 adds the `MODL` section, the compact records of
-//! [`super::records`] as they lie in memory, so loading is one pass over
+//! `model/records.rs` as they lie in memory, so loading is one pass over
 //! the bytes plus [`MtsModel::validate`]; the recipe stays for `mts verify`
 //! and for building again, and is decoded but not built. Files of versions
 //! 1 and 2 still load (built again).

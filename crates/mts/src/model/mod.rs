@@ -4,7 +4,7 @@
 //! Strip `s` owns the records `strip_records[s]..strip_records[s + 1]` and
 //! the beginnings `strip_begins[s]..strip_begins[s + 1]`. A node (the
 //! paper's `ColumnNode`) names one vertex; its arcs (`RowNode`s) are
-//! consecutive records ([`records`] gives the layout), each with a target
+//! consecutive records (`records.rs` gives the layout), each with a target
 //! and a label `res`: the arc may be walked at every LoD up to and
 //! including `res`. A node's arcs are valid over consecutive, disjoint LoD
 //! intervals in the order they are stored, so at LoD `L` the valid arc is
@@ -68,6 +68,28 @@ pub const NODE_MASK: u32 = RESTART - 1;
 /// has label `max_lod`; a strip's slot size is the length of its walk at
 /// its band's first LoD.
 /// The LoD → triangle table is the contraction sequence's.
+///
+/// # Example
+///
+/// ```
+/// use mts::mesh::generate::Generated;
+/// use mts::model::{build_from_mesh, PipelineOptions};
+/// use mts::MtsModel;
+///
+/// let mesh = "torus:2k".parse::<Generated>()?.build();
+/// let (model, _, _) = build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {});
+/// // LoD 0 is the full mesh; each LoD one contraction more, never more triangles.
+/// assert_eq!(model.triangle_count(0), mesh.triangle_count());
+/// assert!(model.triangle_counts().windows(2).all(|w| w[0] >= w[1]));
+/// // The finest LoD with at most a quarter of the triangles.
+/// let lod = model.lod_for_ratio(0.25);
+/// assert!(model.triangle_count(lod) <= mesh.triangle_count() / 4);
+/// // Saved ready to walk and loaded back (checked against its recipe): the same model.
+/// let loaded = MtsModel::from_bytes(&model.to_bytes(), std::path::Path::new("torus.mts"))?;
+/// assert_eq!(loaded, model);
+/// assert_eq!(model.validate(), Ok(()));
+/// # Ok::<(), mts::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct MtsModel {
     pub(crate) positions: Vec<Vec3>,

@@ -33,9 +33,9 @@ pub struct PipelineTimings {
     pub total: Duration,
 }
 
-/// Builds the MTS model of `mesh`: [`stripify`] and [`simplify`] at once on
-/// two threads, then [`super::build`]. `progress(lods_done, max_lod)` is
-/// called as the graph construction advances. Returns the model, where and
+/// Builds the MTS model of `mesh`: [`stripify()`] and [`simplify()`] at
+/// once on two threads, then [`super::build`]. `progress(lods_done,
+/// max_lod)` is called as the graph construction advances. Returns the model, where and
 /// why the contraction sequence stopped, and the stage timings.
 ///
 /// Cost: that of the three stages; peak memory about the sum of their
@@ -45,6 +45,24 @@ pub struct PipelineTimings {
 /// As [`super::build`]: optimal placement on a mesh with properties is
 /// refused ([`super::can_build`]); [`try_build_from_mesh`] returns that as
 /// an error instead.
+///
+/// # Example
+///
+/// ```
+/// use mts::mesh::generate::Generated;
+/// use mts::model::{build_from_mesh, PipelineOptions};
+///
+/// let mesh = "icosphere:5k".parse::<Generated>()?.build();
+/// let mut progress_calls = 0;
+/// let (model, stop, timings) =
+///     build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| progress_calls += 1);
+/// // LoD 0 is the full mesh, and there is one LoD per contraction made.
+/// assert_eq!(model.triangle_count(0), mesh.triangle_count());
+/// assert_eq!(model.max_lod(), stop.lod);
+/// assert_eq!(model.triangle_count(model.max_lod()), stop.triangles);
+/// assert!(progress_calls > 0 && timings.model <= timings.total);
+/// # Ok::<(), mts::Error>(())
+/// ```
 #[must_use]
 pub fn build_from_mesh(
     mesh: &Mesh,
@@ -65,6 +83,23 @@ pub fn build_from_mesh(
 ///
 /// # Errors
 /// [`crate::Error::InvalidArgument`] naming the options.
+///
+/// # Example
+///
+/// ```
+/// use mts::mesh::generate::Generated;
+/// use mts::model::{try_build_from_mesh, PipelineOptions};
+/// use mts::simplify::Placement;
+///
+/// // A torus with UVs, seams, normals and colours.
+/// let mesh = "torus:2k".parse::<Generated>()?.build_with_properties();
+/// let mut options = PipelineOptions::default();
+/// assert!(try_build_from_mesh(&mesh, &options, &mut |_, _| {}).is_ok());
+/// options.simplify.placement = Placement::Optimal;
+/// let refused = try_build_from_mesh(&mesh, &options, &mut |_, _| {});
+/// assert!(matches!(refused, Err(mts::Error::InvalidArgument(_))));
+/// # Ok::<(), mts::Error>(())
+/// ```
 pub fn try_build_from_mesh(
     mesh: &Mesh,
     options: &PipelineOptions,

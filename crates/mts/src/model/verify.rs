@@ -1,5 +1,5 @@
 //! Checks a model against the invariant every test leans on
-//! (`../shared/DESIGN.md`, "The one invariant"): at each LoD the oriented
+//! (`docs/design.md`, "The invariant"): at each LoD the oriented
 //! triangles drawn from the extracted strips are exactly those of the naive
 //! replay of the contraction sequence, and coherent extraction is
 //! byte-identical to extraction from scratch. On a model with seams

@@ -1,6 +1,6 @@
 //! The recorded contraction sequence that defines every level of detail.
 //!
-//! LoD `k` is the mesh after the first `k` contractions (`../shared/DESIGN.md`,
+//! LoD `k` is the mesh after the first `k` contractions (`docs/design.md`,
 //! "Level-of-detail numbering"). Vertices are never moved: a contraction
 //! makes one vertex the *representative* of another, and triangles keep
 //! their original indices, read through the representatives of the LoD.

@@ -1,6 +1,6 @@
 //! Hierarchical clustering by closest representatives, section 4 of the
-//! cluster-tree paper (`../shared/papers/cluster-tree-incremental-encoding.txt`,
-//! "Construction of the cluster tree").
+//! cluster-tree paper (Schmalstieg and Schaufler, "Incremental encoding of
+//! polygonal models", 1997: "Construction of the cluster tree").
 //!
 //! Every vertex starts as its own cluster; the two clusters with the
 //! closest representatives are joined, and the joint cluster keeps one of

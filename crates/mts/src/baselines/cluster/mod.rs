@@ -1,5 +1,5 @@
-//! The cluster tree after "Incremental encoding of polygonal models"
-//! (`../shared/papers/cluster-tree-incremental-encoding.txt`), sections 4
+//! The cluster tree after Schmalstieg and Schaufler, "Incremental encoding
+//! of polygonal models" (HICSS 1997), sections 4
 //! to 7: hierarchical vertex clustering (`build.rs`), the update and
 //! collapsed lists of each node, LoD selection by a cluster-size threshold,
 //! refinement and simplification between LoDs, and the linearized packet

@@ -4,9 +4,8 @@
 //!
 //! After Hoppe, "Optimization of mesh locality for transparent vertex
 //! caching" (SIGGRAPH 1999), whose strips run side by side in bands as wide
-//! as the cache holds (followed from memory of the paper, which is not in
-//! `../shared/papers`; the construction below is ours,
-//! docs/experiments/vertex-work.md).
+//! as the cache holds (followed from memory of the paper; the construction
+//! below is ours, docs/experiments/vertex-work.md).
 //!
 //! A band starts with a strip grown greedily (no swap first, then a cached
 //! new vertex, then fewest free neighbours) until it has missed the cache

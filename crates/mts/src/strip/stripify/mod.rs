@@ -3,11 +3,11 @@
 //! After Evans, Skiena and Varshney, "Optimizing triangle strips for fast
 //! rendering" (IEEE Visualization 1996), the search the MTS paper (section
 //! 2.2) uses: a global pass finds large rectangular patches of
-//! quadrilaterals and strips them along their rows ([`patches`]); a local
+//! quadrilaterals and strips them along their rows (`patches.rs`); a local
 //! greedy pass strips what is left, starting from the triangle with fewest
-//! free neighbours and avoiding swaps ([`greedy`]). Both build strips as
-//! walks over triangles; [`path`] turns a walk into a vertex run. An
-//! option replaces both passes with a cache-aware local pass ([`cache`]):
+//! free neighbours and avoiding swaps (`greedy.rs`). Both build strips as
+//! walks over triangles; `path.rs` turns a walk into a vertex run. An
+//! option replaces both passes with a cache-aware local pass (`cache.rs`):
 //! short strips in rows, each around the last row's vertices, for vertex
 //! reuse as well as index count.
 //!
@@ -79,10 +79,10 @@ pub struct StripifyOptions {
     /// (bunny: 13 joins, icosphere 100K: 29).
     pub join_ends: bool,
     /// Strip for the vertex cache as well as for index count: one
-    /// cache-aware local pass ([`cache`]) replaces the passes above (the
-    /// other fields are then ignored). Off by default: on the shared
-    /// models its FIFO-16 ACMR is within +0.05 of a cache-ordered list's
-    /// on 18 of 20 (the default's is 0.19–0.34 above), but it sends 22–34%
+    /// cache-aware local pass (`stripify/cache.rs`) replaces the passes
+    /// above (the other fields are then ignored). Off by default: on the
+    /// shared models its FIFO-16 ACMR is within +0.05 of a cache-ordered
+    /// list's on 18 of 20 (the default's is 0.19–0.34 above), but it sends 22–34%
     /// more indices than the default and 6–22% more than meshoptimizer's
     /// strips, and a driver that empties its vertex cache at each restart
     /// (lavapipe) loses the reuse unless the runs are stitched
