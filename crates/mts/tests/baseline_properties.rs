@@ -12,7 +12,7 @@ use mts::baselines::cluster::stream;
 use mts::baselines::{ClusterTree, MultilevelMesh, ProgressiveMesh};
 use mts::mesh::generate::Generated;
 use mts::mesh::{clean, Properties, RawMesh};
-use mts::model::sequence;
+use mts::model::requests;
 use mts::strip::sorted_canonical;
 use mts::{Collapses, LodSource, Mesh};
 use proptest::prelude::*;
@@ -107,7 +107,7 @@ fn spread(max_lod: usize) -> Vec<usize> {
     let mut l: Vec<usize> = (0..=max_lod).step_by((max_lod / 40).max(1)).collect();
     l.push(max_lod);
     l.extend((0..=max_lod).rev().step_by((max_lod / 25).max(1)));
-    l.extend(sequence::random(max_lod, 60, 3));
+    l.extend(requests::random(max_lod, 60, 3));
     l
 }
 
@@ -385,7 +385,7 @@ proptest! {
     fn random_seamed_meshes_every_lod(mesh in random_seamed_surface()) {
         let c = collapses(&mesh);
         let mut lods: Vec<usize> = (0..=c.max_lod()).collect();
-        lods.extend(sequence::random(c.max_lod(), 20, 5));
+        lods.extend(requests::random(c.max_lod(), 20, 5));
         let mut pm = ProgressiveMesh::new(&mesh, &c).unwrap();
         pm.validate().unwrap();
         check(&mesh, &c, &mut pm, &lods);
