@@ -11,24 +11,10 @@ mod args;
 mod bench;
 mod commands;
 mod demo_scene;
-mod render;
+mod gltf_scene;
 mod stdout;
 mod timing;
 mod viewer;
-
-// What the rendering commands (render.rs, viewer.rs) reach at the crate's
-// root.
-pub(crate) use args::{check_output, count_in, pixel_error, LevelArgs, MeshSource};
-pub(crate) use mts::methods::Method;
-
-/// The source of `method` over `model` (render.rs's name for it).
-pub(crate) fn make_source<'m>(
-    method: Method,
-    model: &'m mts::MtsModel,
-    mesh: &mts::Mesh,
-) -> Result<Box<dyn mts::LodSource + 'm>> {
-    Ok(method.source(model, mesh)?)
-}
 
 #[derive(Parser)]
 #[command(
@@ -63,6 +49,9 @@ enum Command {
     Info(commands::info::InfoArgs),
     /// Extract one LoD of a model as restart-encoded strips.
     Extract(commands::extract::ExtractArgs),
+    /// Write a chain of LoDs as one glTF file with MSFT_lod (each level an
+    /// indexed list in vertex-cache order with its own vertices).
+    Lods(commands::lods::LodsArgs),
     /// Encode a mesh as the cluster tree's packet stream (a progressive,
     /// incrementally decodable file).
     Encode(commands::encode::EncodeArgs),
@@ -81,10 +70,10 @@ enum Command {
     Bench(commands::bench::BenchArgs),
     /// Draw one LoD headless (Mesa's lavapipe without a GPU) into a PNG,
     /// by the MTS strips or the oracle triangle list.
-    Render(render::RenderArgs),
+    Render(commands::render::RenderArgs),
     /// Open a window on a model (orbit camera; wheel, Up/Down change the
     /// LoD, A toggles the automatic LoD, Escape quits).
-    View(render::ViewArgs),
+    View(commands::view::ViewArgs),
 }
 
 fn run(cli: &Cli) -> Result<()> {
@@ -98,13 +87,14 @@ fn run(cli: &Cli) -> Result<()> {
         Command::Build(args) => c::build::run(args),
         Command::Info(args) => c::info::run(args),
         Command::Extract(args) => c::extract::run(args),
+        Command::Lods(args) => c::lods::run(args),
         Command::Encode(args) => c::encode::run(args),
         Command::Decode(args) => c::decode::run(args),
         Command::Compare(args) => c::compare::run(args),
         Command::Verify(args) => c::verify::run(args),
         Command::Bench(args) => c::bench::run(args),
-        Command::Render(args) => render::render(args),
-        Command::View(args) => render::view(args),
+        Command::Render(args) => c::render::run(args),
+        Command::View(args) => c::view::run(args),
     }
 }
 

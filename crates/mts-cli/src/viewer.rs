@@ -1,5 +1,7 @@
-//! `mts view`: a window (winit) with an orbit camera around one model, or
-//! the demo layout ([`DemoScene`]) of an `InstancedScene`, drawn by the same renderer as everything else.
+//! `mts view`: a window (winit) with an orbit camera around one model, the
+//! demo layout ([`DemoScene`]) of an `InstancedScene`, or the parts of a
+//! glTF scene ([`GltfScene`]) in one, drawn by the same renderer as
+//! everything else.
 //!
 //! Controls: drag with the left button (or the arrow keys) to orbit, `W`/`S`
 //! to move closer or farther; the mouse wheel, `Up`/`Down` or `+`/`-`
@@ -11,13 +13,16 @@
 //! and frames per second.
 
 use crate::demo_scene::DemoScene;
+use crate::gltf_scene::GltfScene;
 use crate::stdout::warnln;
 use glam::Vec3;
 use mts::model::Extractor;
 use mts::{Error, MtsModel, Result};
 use mts_render::camera::Camera;
 use mts_render::gpu::AdapterReport;
+use mts_render::scene::DEFAULT_PIXEL_ERROR;
 use mts_render::strip_renderer::{RendererConfig, StripRenderer};
+use mts_render::{FrameStats, InstancedScene};
 use std::sync::Arc;
 use std::time::Instant;
 use winit::application::ApplicationHandler;
@@ -81,12 +86,34 @@ pub fn run(
     title: &str,
     max_frames: Option<u64>,
 ) -> Result<ViewerReport> {
-    let event_loop = EventLoop::new().map_err(|e| Error::Gpu(format!("no event loop: {e}")))?;
-    event_loop.set_control_flow(ControlFlow::Poll);
-    let mut app = App {
+    let shown = Shown::Model {
         model,
         others,
         content,
+    };
+    run_app(shown, title, max_frames)
+}
+
+/// [`run`] on the parts of a glTF scene, each instance at the coarsest LoD
+/// within [`DEFAULT_PIXEL_ERROR`], with the checker texture instead of
+/// their own when `checker` is set.
+///
+/// # Errors
+/// As [`run`], and those of [`GltfScene::scene`].
+pub fn run_gltf(
+    scene: &GltfScene,
+    checker: bool,
+    title: &str,
+    max_frames: Option<u64>,
+) -> Result<ViewerReport> {
+    run_app(Shown::Gltf { scene, checker }, title, max_frames)
+}
+
+fn run_app(shown: Shown<'_>, title: &str, max_frames: Option<u64>) -> Result<ViewerReport> {
+    let event_loop = EventLoop::new().map_err(|e| Error::Gpu(format!("no event loop: {e}")))?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        shown,
         title: title.to_owned(),
         max_frames,
         state: None,
@@ -109,11 +136,24 @@ pub fn run(
     })
 }
 
+/// What the window shows, before it opens.
+#[derive(Clone, Copy)]
+enum Shown<'m> {
+    Model {
+        model: &'m MtsModel,
+        /// More models of the scene (instances taken in turn with
+        /// `model`).
+        others: &'m [&'m MtsModel],
+        content: ViewerContent,
+    },
+    Gltf {
+        scene: &'m GltfScene,
+        checker: bool,
+    },
+}
+
 struct App<'m> {
-    model: &'m MtsModel,
-    /// More models of the scene (instances taken in turn with `model`).
-    others: &'m [&'m MtsModel],
-    content: ViewerContent,
+    shown: Shown<'m>,
     title: String,
     max_frames: Option<u64>,
     state: Option<State<'m>>,
@@ -157,6 +197,8 @@ enum Drawn<'m> {
         extractor: Extractor<'m>,
     },
     Scene(DemoScene<'m>),
+    /// The parts of a glTF scene.
+    Parts(InstancedScene<'m>),
 }
 
 /// Orbit camera around `centre`: yaw and pitch in radians, distance in
@@ -194,13 +236,7 @@ impl ApplicationHandler for App<'_> {
         if self.state.is_some() {
             return;
         }
-        match State::new(
-            event_loop,
-            self.model,
-            self.others,
-            self.content,
-            &self.title,
-        ) {
+        match State::new(event_loop, self.shown, &self.title) {
             Ok(state) => self.state = Some(state),
             Err(e) => {
                 self.error = Some(e);
@@ -288,13 +324,7 @@ impl ApplicationHandler for App<'_> {
 }
 
 impl<'m> State<'m> {
-    fn new(
-        event_loop: &ActiveEventLoop,
-        model: &'m MtsModel,
-        others: &[&'m MtsModel],
-        content: ViewerContent,
-        title: &str,
-    ) -> Result<State<'m>> {
+    fn new(event_loop: &ActiveEventLoop, shown: Shown<'m>, title: &str) -> Result<State<'m>> {
         let gpu = |what: &str, e: &dyn std::fmt::Display| Error::Gpu(format!("{what}: {e}"));
         let window = Arc::new(
             event_loop
@@ -338,8 +368,19 @@ impl<'m> State<'m> {
             depth_format: Some(DEPTH_FORMAT),
             strip_mode: report.strip_mode,
         };
-        let (drawn, centre, radius) = match content {
-            ViewerContent::Model { checker } => {
+        let (drawn, centre, radius) = match shown {
+            Shown::Gltf { scene, checker } => {
+                let appearance = mts_render::Appearance { checker };
+                let (parts, _) = scene.scene(&device, &queue, &renderer_config, &appearance)?;
+                let (lo, hi) = scene.bounds();
+                let radius = ((hi - lo).length() * 0.5).max(1e-6);
+                (Drawn::Parts(parts), (lo + hi) * 0.5, radius)
+            }
+            Shown::Model {
+                model,
+                content: ViewerContent::Model { checker },
+                ..
+            } => {
                 let appearance = mts_render::texture::Appearance { checker };
                 let renderer = StripRenderer::for_model_with(
                     &device,
@@ -358,7 +399,11 @@ impl<'m> State<'m> {
                 };
                 (drawn, (lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-6))
             }
-            ViewerContent::Scene { count, checker } => {
+            Shown::Model {
+                model,
+                others,
+                content: ViewerContent::Scene { count, checker },
+            } => {
                 // Stitched on backends that ignore primitive restart.
                 let scene = DemoScene::new(
                     &device,
@@ -401,7 +446,13 @@ impl<'m> State<'m> {
             },
             ratio: 1.0,
             flying: None,
-            auto: matches!(content, ViewerContent::Scene { .. }),
+            auto: !matches!(
+                shown,
+                Shown::Model {
+                    content: ViewerContent::Model { .. },
+                    ..
+                }
+            ),
             dragging: false,
             last_cursor: None,
             extract_us: 0.0,
@@ -428,6 +479,20 @@ impl<'m> State<'m> {
         self.ratio = (self.ratio * LOD_STEP.powf(notches)).clamp(1e-4, 1.0);
     }
 
+    /// Triangles and indices drawn by a scene's update (started at
+    /// `started`), which is timed as an extraction when a LoD changed; a
+    /// failed update draws nothing this frame, with a warning.
+    fn scene_counts(&mut self, stats: Result<FrameStats>, started: Instant) -> (usize, usize) {
+        let stats = stats.unwrap_or_else(|e| {
+            warnln!("scene update: {e}");
+            FrameStats::default()
+        });
+        if stats.lod_changes > 0 {
+            self.extract_us = started.elapsed().as_secs_f64() * 1e6;
+        }
+        (stats.triangles, stats.indices_drawn)
+    }
+
     fn frame(&mut self) -> Result<()> {
         let (w, h) = (self.config.width, self.config.height);
         let aspect = w as f32 / h as f32;
@@ -448,15 +513,13 @@ impl<'m> State<'m> {
                 let lod = if self.auto {
                     // The model's nearest point is about one bounding
                     // radius nearer than the orbit's centre.
-                    let row_y = camera.view_proj.row(1).truncate().length();
                     let nearest = (self.orbit.distance - 1.0).max(0.0) * self.orbit.radius;
-                    let ppu = row_y * 0.5 * h as f32 / nearest;
                     mts::lod_for_screen_error(
                         model.collapses(),
                         2.0 * self.orbit.radius,
                         1.0,
-                        ppu,
-                        mts_render::scene::DEFAULT_PIXEL_ERROR,
+                        camera.projection(h as f32).pixels_per_unit(nearest),
+                        DEFAULT_PIXEL_ERROR,
                     )
                 } else {
                     model.lod_for_ratio(self.ratio)
@@ -470,22 +533,24 @@ impl<'m> State<'m> {
                 (model.triangle_count(lod), extractor.indices_sent())
             }
             Drawn::Scene(scene) => {
-                let stats = scene
-                    .update(
-                        &self.device,
-                        &self.queue,
-                        &camera,
-                        h as f32,
-                        mts_render::scene::DEFAULT_PIXEL_ERROR,
-                    )
-                    .unwrap_or_else(|e| {
-                        warnln!("scene update: {e}");
-                        mts_render::FrameStats::default()
-                    });
-                if stats.lod_changes > 0 {
-                    self.extract_us = t.elapsed().as_secs_f64() * 1e6;
-                }
-                (stats.triangles, stats.indices_drawn)
+                let stats = scene.update(
+                    &self.device,
+                    &self.queue,
+                    &camera,
+                    h as f32,
+                    DEFAULT_PIXEL_ERROR,
+                );
+                self.scene_counts(stats, t)
+            }
+            Drawn::Parts(scene) => {
+                let stats = scene.update(
+                    &self.device,
+                    &self.queue,
+                    &camera,
+                    h as f32,
+                    DEFAULT_PIXEL_ERROR,
+                );
+                self.scene_counts(stats, t)
             }
         };
         let frame = match self.surface.get_current_texture() {
@@ -513,6 +578,7 @@ impl<'m> State<'m> {
             match &self.drawn {
                 Drawn::Model { renderer, .. } => renderer.draw(&mut pass),
                 Drawn::Scene(scene) => scene.draw(&mut pass),
+                Drawn::Parts(scene) => scene.draw(&mut pass),
             }
         }
         self.queue.submit([encoder.finish()]);

@@ -251,3 +251,59 @@ fn render_scene_reports_shared_buckets_by_screen_error() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `mts lods` (issue 32): a chain of five levels in one `.glb`, finest
+/// first, each with fewer triangles and only its own vertices, screen
+/// coverages falling to 0; the file read back by the project's reader is
+/// the finest level (the node a viewer without `MSFT_lod` draws), with
+/// its properties; a share above 1 is refused.
+#[test]
+fn lods_writes_a_chain_that_reads_back() {
+    let dir = std::env::temp_dir().join(format!("mts-cli-lods-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let glb = dir.join("chain.glb");
+    let glb = glb.to_str().unwrap();
+    let src = ["--generated", "torus:5k", "--properties"];
+    let (ok, out, err) = mts(&[&["lods"][..], &src, &["-o", glb, "--json"]].concat());
+    assert!(ok, "{err}");
+    let v = json(&out);
+    let levels = v["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 5, "{out}");
+    let n = |l: &serde_json::Value, k: &str| l[k].as_u64().unwrap();
+    assert_eq!(n(&levels[0], "triangles"), 4900);
+    for w in levels.windows(2) {
+        assert!(n(&w[1], "triangles") < n(&w[0], "triangles"), "{out}");
+        assert!(n(&w[1], "vertices") < n(&w[0], "vertices"), "{out}");
+        let c = |l: &serde_json::Value| l["screen_coverage"].as_f64().unwrap();
+        assert!(c(&w[1]) <= c(&w[0]), "{out}");
+    }
+    assert_eq!(levels[4]["screen_coverage"].as_f64(), Some(0.0));
+    // At most 2% of the triangles at the last level.
+    assert!(n(&levels[4], "triangles") <= 98, "{out}");
+    assert_eq!(
+        v["bytes"].as_u64().unwrap(),
+        std::fs::metadata(glb).unwrap().len()
+    );
+    let (ok, out, err) = mts(&["strips", glb, "--repeat", "1", "--json"]);
+    assert!(ok, "{err}");
+    let s = json(&out);
+    assert_eq!(s["triangles"].as_u64(), Some(4900));
+    assert_eq!(s["vertices"].as_u64(), Some(n(&levels[0], "vertices")));
+    // Share 0 is the coarsest LoD the sequence reached (a torus keeps some
+    // triangles); a share above 1 is refused before any work.
+    let (ok, out, err) = mts(&[
+        &["lods"][..],
+        &src,
+        &["-o", glb, "--ratios", "0,1", "--json"],
+    ]
+    .concat());
+    assert!(ok, "{err}");
+    let last = &json(&out)["levels"][1];
+    assert!(
+        n(last, "triangles") > 0 && n(last, "triangles") < 100,
+        "{out}"
+    );
+    let (ok, _, err) = mts(&[&["lods"][..], &src, &["-o", glb, "--ratios", "1,1.5"]].concat());
+    assert!(!ok && err.contains("outside 0..=1"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -88,6 +88,42 @@ impl Camera {
         }
     }
 
+    /// How this camera turns world units into pixels on a viewport
+    /// `viewport_height` pixels high, for the core's screen-space error
+    /// rule ([`mts::lod_for_screen_error`], [`mts::Projection`]): read
+    /// from [`Camera::view_proj`], whose view part must be a rotation and
+    /// translation (as [`Camera::looking`] and [`Camera::framing`] make).
+    /// A perspective matrix (a clip `w` that depends on the point) gives
+    /// [`mts::Projection::Perspective`] with the field of view whose
+    /// half-angle's cotangent is the projection's `y` scale (the length of
+    /// the matrix's second row); otherwise the matrix is orthographic and
+    /// shows `2 / y scale` world units over the viewport's height.
+    ///
+    /// Cost: O(1).
+    #[must_use]
+    pub fn projection(&self, viewport_height: f32) -> mts::Projection {
+        let y_scale = self.view_proj.row(1).truncate().length();
+        if self.view_proj.row(3).truncate() == Vec3::ZERO {
+            mts::Projection::Orthographic {
+                view_height: 2.0 / y_scale,
+                viewport_height,
+            }
+        } else {
+            mts::Projection::Perspective {
+                fov_y: 2.0 * (1.0 / y_scale).atan(),
+                viewport_height,
+            }
+        }
+    }
+
+    /// Depth of `point` in front of the eye along the view axis, world
+    /// units (the clip `w` of a perspective camera; 1 for an orthographic
+    /// one, whose pixels per unit do not depend on it).
+    #[must_use]
+    pub fn depth_of(&self, point: Vec3) -> f32 {
+        self.view_proj.row(3).dot(point.extend(1.0))
+    }
+
     /// [`Camera::framing`] of the bounding box of `positions` (a unit
     /// sphere at the origin when there are none). Cost: O(positions).
     #[must_use]
@@ -100,6 +136,39 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The projection read back from the matrix has the field of view it
+    /// was made with, and a world unit face-on at depth `d` covers the
+    /// pixels the matrix maps it to.
+    #[test]
+    fn projection_is_read_back_from_the_matrix() {
+        let c = Camera::looking(Vec3::new(1.0, 2.0, 9.0), Vec3::ZERO, 1.5, 0.1, 100.0);
+        let mts::Projection::Perspective {
+            fov_y,
+            viewport_height,
+        } = c.projection(600.0)
+        else {
+            panic!("a perspective camera");
+        };
+        assert!((fov_y - FRAMING_FOV_Y).abs() < 1e-6, "{fov_y}");
+        assert_eq!(viewport_height, 600.0);
+        let eye = Vec3::new(1.0, 2.0, 9.0);
+        let forward = -eye.normalize();
+        let up = forward.cross(Vec3::Y).cross(forward).normalize();
+        let at = eye + forward * 7.0;
+        assert!((c.depth_of(at) - 7.0).abs() < 1e-4);
+        let ndc = |p: Vec3| c.view_proj.project_point3(p).y;
+        let pixels = (ndc(at + up) - ndc(at)) * 0.5 * 600.0;
+        let ppu = c.projection(600.0).pixels_per_unit(7.0);
+        assert!((pixels - ppu).abs() < 1e-3 * ppu, "{pixels} {ppu}");
+        let ortho = Camera {
+            view_proj: glam::camera::rh::proj::directx::orthographic(
+                -4.0, 4.0, -2.5, 2.5, 0.0, 10.0,
+            ),
+            ..c
+        };
+        assert_eq!(ortho.projection(500.0).pixels_per_unit(3.0), 100.0);
+    }
 
     #[test]
     fn framed_box_corners_are_inside_the_view() {

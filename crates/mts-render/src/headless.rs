@@ -108,6 +108,54 @@ impl Image {
         }
     }
 
+    /// Reads a PNG (any colour type and depth: palettes, grey and 16-bit
+    /// samples are expanded or stripped to 8-bit RGBA, opaque where it has
+    /// no alpha), as [`Image::save_png`] writes one: for hosts and tests
+    /// that check what a command drew.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read, [`Error::Parse`] naming
+    /// it when it is not a PNG the decoder reads.
+    ///
+    /// Cost: O(file + pixels); holds the file and the image.
+    pub fn read_png(path: &Path) -> Result<Image> {
+        let bytes = mts::mesh::io::read_file(path)?;
+        let not_png = |e: png::DecodingError| Error::Parse {
+            file: path.to_owned(),
+            place: mts::Place::default(),
+            message: format!("not a PNG this reader decodes: {e}"),
+        };
+        let mut decoder = png::Decoder::new(std::io::Cursor::new(&bytes[..]));
+        decoder.set_transformations(png::Transformations::normalize_to_color8());
+        let mut reader = decoder.read_info().map_err(not_png)?;
+        let size = reader.output_buffer_size().ok_or_else(|| Error::Parse {
+            file: path.to_owned(),
+            place: mts::Place::default(),
+            message: "the image is too large for memory".into(),
+        })?;
+        let mut buffer = vec![0; size];
+        let info = reader.next_frame(&mut buffer).map_err(not_png)?;
+        buffer.truncate(info.buffer_size());
+        let rgba = match info.color_type {
+            png::ColorType::Rgba => buffer,
+            png::ColorType::Rgb => buffer
+                .chunks_exact(3)
+                .flat_map(|p| [p[0], p[1], p[2], 255])
+                .collect(),
+            png::ColorType::GrayscaleAlpha => buffer
+                .chunks_exact(2)
+                .flat_map(|p| [p[0], p[0], p[0], p[1]])
+                .collect(),
+            // Grey: palettes were expanded to RGB(A).
+            _ => buffer.iter().flat_map(|&g| [g, g, g, 255]).collect(),
+        };
+        Ok(Image {
+            width: info.width,
+            height: info.height,
+            rgba,
+        })
+    }
+
     /// Writes the image as an 8-bit RGBA PNG.
     ///
     /// # Errors
@@ -462,5 +510,22 @@ mod tests {
             rgba: vec![0; 16],
         };
         assert_eq!(reference.difference(&other_size, 8).share, 1.0);
+    }
+
+    /// What `save_png` writes, `read_png` reads back byte for byte; a file
+    /// that is not a PNG is a parse error naming it.
+    #[test]
+    fn png_round_trips() {
+        let dir = std::env::temp_dir().join(format!("mts-png-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let original = image([[200, 10, 30], [64, 64, 64], [0, 255, 7]]);
+        let path = dir.join("a.png");
+        original.save_png(&path).unwrap();
+        assert_eq!(Image::read_png(&path).unwrap(), original);
+        let bad = dir.join("b.png");
+        std::fs::write(&bad, b"not a png").unwrap();
+        let e = Image::read_png(&bad).unwrap_err().to_string();
+        assert!(e.contains("b.png") && e.contains("not a PNG"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

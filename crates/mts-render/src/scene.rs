@@ -5,8 +5,9 @@
 //!
 //! **LoD choice.** Each visible instance gets the coarsest LoD whose
 //! recorded error ([`mts::lod_for_screen_error`]), scaled by the instance's
-//! largest axis scale and projected at the nearest point of its bounding
-//! sphere, covers at most the host's pixel threshold.
+//! largest axis scale and projected at the nearest depth of its bounding
+//! sphere, covers at most the host's pixel threshold: the core's rule, with
+//! the camera's [`mts::Projection`] ([`Camera::projection`]).
 //!
 //! **Shared extraction.** A model's LoDs are grouped in buckets: bucket
 //! `b` is the finest LoD with at most `T × (1 − s)^b` triangles (`T` the
@@ -249,6 +250,52 @@ struct ModelEntry<'m> {
 
 /// Several models, each with instances the host places (see the module
 /// docs).
+///
+/// # Example
+///
+/// One model placed near and far: each instance is drawn at the coarsest
+/// LoD whose error covers at most one pixel, so the far one draws fewer
+/// triangles. It needs a graphics adapter (Mesa's lavapipe draws it
+/// without a GPU); without one it is skipped with a message, as the
+/// renderer's tests are, unless `MTS_REQUIRE` names `gpu` (as in CI),
+/// where it fails.
+///
+/// ```
+/// use glam::{Mat4, Vec3};
+/// use mts::mesh::generate::Generated;
+/// use mts::model::{try_build_from_mesh, PipelineOptions};
+/// use mts_render::{Camera, Gpu, HeadlessTarget, InstancedScene, RendererConfig};
+///
+/// # fn main() -> Result<(), mts::Error> {
+/// let mesh = "torus:4k".parse::<Generated>()?.build();
+/// let (model, _, _) = try_build_from_mesh(&mesh, &PipelineOptions::default(), &mut |_, _| {})?;
+/// # if let Err(mts::Error::NoAdapter(why)) = Gpu::new_headless() {
+/// #     let required = std::env::var("MTS_REQUIRE")
+/// #         .is_ok_and(|v| v.split(',').any(|w| w.trim() == "gpu"));
+/// #     assert!(!required, "MTS_REQUIRE names gpu: no adapter ({why})");
+/// #     eprintln!("skipped: no graphics adapter ({why})");
+/// #     return Ok(());
+/// # }
+/// let gpu = Gpu::new_headless()?;
+/// let (device, queue) = (&gpu.device, &gpu.queue);
+/// let target = HeadlessTarget::new(device, 640, 480)?;
+/// let mut scene = InstancedScene::new(&RendererConfig::headless(gpu.report().strip_mode));
+/// let torus = scene.add_model(device, queue, &model)?;
+/// let d = mesh.diagonal(); // model units
+/// let near = scene.add_instance(torus, Mat4::from_translation(Vec3::new(0.0, 0.0, -2.0 * d)))?;
+/// let far = scene.add_instance(torus, Mat4::from_translation(Vec3::new(d, 0.0, -40.0 * d)))?;
+/// let camera = Camera::looking(Vec3::ZERO, Vec3::NEG_Z, target.aspect(), 0.1 * d, 100.0 * d);
+/// // Once per frame: cull, choose LoDs (1 pixel over 480), extract what
+/// // is newly needed, then draw into any render pass.
+/// let stats = scene.update(device, queue, &camera, 480.0, 1.0)?;
+/// let image = target.render_image(device, queue, |pass| scene.draw(pass))?;
+/// assert_eq!(stats.visible, 2);
+/// assert!(scene.lod_of(near) < scene.lod_of(far), "the far instance is coarser");
+/// assert!(stats.triangles < 2 * mesh.triangle_count());
+/// assert!(image.foreground_pixels() > 0);
+/// # Ok(())
+/// # }
+/// ```
 pub struct InstancedScene<'m> {
     config: RendererConfig,
     spacing: f32,
@@ -559,6 +606,14 @@ impl<'m> InstancedScene<'m> {
             .map_or(&[], |e| e.renderer.warnings())
     }
 
+    /// Width and height of the base-colour texture `model` is drawn with,
+    /// `None` when it is drawn untextured (or is not of this scene), as
+    /// [`StripRenderer::texture_size`].
+    #[must_use]
+    pub fn texture_size(&self, model: ModelId) -> Option<(u32, u32)> {
+        self.models.get(model.0 as usize)?.renderer.texture_size()
+    }
+
     /// Where the scene's memory goes now.
     #[must_use]
     pub fn memory(&self) -> SceneMemory {
@@ -655,12 +710,7 @@ impl<'m> InstancedScene<'m> {
                 b.placed = 0;
             }
         }
-        // Pixels per world unit at view depth 1: the projection's y scale
-        // (the length of the matrix's second row, the view being a
-        // rotation) times half the viewport.
-        let row_y = camera.view_proj.row(1).truncate().length();
-        let row_w = camera.view_proj.row(3);
-        let px_at_1 = row_y * 0.5 * viewport_height;
+        let projection = camera.projection(viewport_height);
         std::mem::swap(&mut self.visible, &mut self.previous);
         self.visible.clear();
         self.visible
@@ -679,18 +729,14 @@ impl<'m> InstancedScene<'m> {
         for &id in &self.visible {
             let entry = &mut self.models[id.model as usize];
             let slot = &mut entry.slots[id.slot as usize];
-            let depth = row_w.dot(slot.bound.centre.extend(1.0));
-            let nearest = (depth - slot.bound.radius).max(0.0);
-            let ppu = if nearest > 0.0 {
-                px_at_1 / nearest
-            } else {
-                f32::INFINITY
-            };
+            // The bound's nearest depth: the instance's nearest point is no
+            // nearer (infinite pixels per unit, full detail, at 0).
+            let nearest = (camera.depth_of(slot.bound.centre) - slot.bound.radius).max(0.0);
             let lod = mts::lod_for_screen_error(
                 entry.model.collapses(),
                 entry.diagonal,
                 slot.scale,
-                ppu,
+                projection.pixels_per_unit(nearest),
                 pixel_error,
             );
             // The coarsest bucket at least as fine as `lod`.

@@ -10,7 +10,7 @@ use super::scene::{scene_rows, SceneSpec, SCENE_COMPARED_FRAMES};
 use super::vertex_work::measure_vertex_work;
 use crate::args::MeshSource;
 use crate::bench::results::{Scene, VertexWork};
-use crate::render::Size;
+use crate::commands::render::Size;
 use crate::stdout::outln;
 use anyhow::Result;
 use clap::Args;

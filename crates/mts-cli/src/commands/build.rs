@@ -1,7 +1,7 @@
 //! `mts build`: build the MTS model and write it as an `.mts` file.
 
 use crate::args::*;
-use crate::stdout::outln;
+use crate::stdout::{outln, warnln};
 use anyhow::{bail, Result};
 use clap::Args;
 use mts::mesh::Mesh;
@@ -80,6 +80,7 @@ pub fn run(args: &BuildArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let (name, mesh, _) = args.source.load()?;
     let load = started.elapsed();
+    note_gltf_parts(&args.source)?;
     let options = args.pipeline_options();
     if args.optimal && !mesh.properties.is_empty() {
         bail!(
@@ -197,4 +198,33 @@ pub fn build_with_bar(
     });
     bar.finish_and_clear();
     out
+}
+
+/// What `build` does with a glTF file of several parts (mesh primitives):
+/// the `.mts` file holds one model, so they are merged, each placed by its
+/// node, with one texture; said once, since `render` and `view` draw such
+/// a file part by part.
+fn note_gltf_parts(source: &MeshSource) -> Result<()> {
+    let Some(path) = &source.mesh else {
+        return Ok(());
+    };
+    let gltf = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+    if !gltf {
+        return Ok(());
+    }
+    let bytes = mts::mesh::io::read_file(path)?;
+    if mts::mesh::io::Format::detect(path, &bytes)? != mts::mesh::io::Format::Gltf {
+        return Ok(());
+    }
+    let n = mts::mesh::io::gltf_part_count(&bytes, path)?;
+    if n > 1 {
+        warnln!(
+            "note: {}: {n} parts (mesh primitives): `build` merges them, each placed by its node, into one model with one texture, the first part's; `mts render` and `mts view` draw every part with its own",
+            path.display()
+        );
+    }
+    Ok(())
 }

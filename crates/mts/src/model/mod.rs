@@ -33,8 +33,8 @@ mod extract;
 pub mod format;
 mod pipeline;
 pub(crate) mod records;
-mod segments;
 pub mod requests;
+mod segments;
 mod verify;
 
 pub use build::{

@@ -10,6 +10,7 @@
 pub use crate::encoding::{decode_restart_buffer, decode_run};
 
 pub mod acmr;
+pub mod cache_order;
 pub mod encode;
 pub mod stats;
 pub mod stripify;

@@ -36,6 +36,15 @@
 //! apart. Cost: a model with several textures (an atlas per part) is drawn
 //! with the first one only.
 //!
+//! **Or kept apart, as parts.** [`parse_gltf_parts`] reads the same scene
+//! as one [`GltfPart`] per triangle primitive of each mesh reached: its
+//! vertices untransformed, its own properties and base-colour texture,
+//! and the world matrix of every node that holds the mesh (a mesh under
+//! several nodes is read once, placed several times). It is what a scene
+//! renderer instances, one model per part; the pipeline's one surface is
+//! still [`parse_gltf`]'s. [`gltf_part_count`] counts the parts from the
+//! JSON alone, for a command to tell which of the two it needs.
+//!
 //! **Attributes only some primitives have** are filled for the others with
 //! a neutral value: normal zero (no normal, computed where drawn), texture
 //! coordinate `(0, 0)`, colour white (times the material's factor). A
@@ -92,7 +101,7 @@ use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::Checked;
 use serde_json::Value;
 use std::borrow::Cow;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Extensions a file may require that this reader honours: quantized
@@ -101,9 +110,20 @@ use std::path::{Path, PathBuf};
 const SUPPORTED_REQUIRED: &[&str] = &["KHR_mesh_quantization", "KHR_materials_unlit"];
 
 /// Parses a `.gltf` or `.glb` file (told apart by the GLB magic `glTF`)
-/// into one [`RawMesh`], as described in the module docs. External buffers
-/// are read with [`read_file`] relative to `path`'s folder; an external
-/// base-colour image is only named ([`Texture::File`]), not read.
+/// into one [`RawMesh`], as described in the module docs: every instance
+/// of every triangle primitive, transformed into world space, in scene
+/// order (depth first, children in order). External buffers are read with
+/// [`read_file`] relative to `path`'s folder; an external base-colour image
+/// is only named ([`Texture::File`]), not read.
+///
+/// **Several textures.** A [`RawMesh`] has one texture: the mesh keeps the
+/// base-colour texture of the first primitive in scene order whose
+/// material has one, and every primitive's texture coordinates sample it;
+/// a primitive whose material samples another image is drawn with that
+/// first image (a note on stderr names both). The base-colour factors are
+/// kept as vertex colours. [`parse_gltf_parts`] keeps every primitive
+/// apart with its own texture, and [`gltf_part_count`] tells, without
+/// reading any buffer, whether a file has more than one.
 ///
 /// # Errors
 /// [`Error::Parse`] with the JSON object (and the byte, for GLB data) at
@@ -124,28 +144,121 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<RawMesh> {
 /// As [`parse_gltf`]; [`Error::Parse`] naming the primitive whose instance
 /// passes the limit.
 pub fn parse_gltf_with(bytes: &[u8], path: &Path, max_triangles: u64) -> Result<RawMesh> {
-    let (text, bin) = if bytes.starts_with(b"glTF") {
+    let (root, bin) = parse_container(bytes, path)?;
+    let mut reader = Reader::new(&root, path, bin, max_triangles, Target::Merged);
+    reader.check_extensions()?;
+    reader.read_scene()?;
+    reader.finish()
+}
+
+/// One part of a glTF scene ([`parse_gltf_parts`]): a triangle primitive
+/// of a mesh, in the mesh's own coordinates, with its own vertex
+/// properties and base-colour texture, and every world matrix the scene
+/// places the mesh at.
+#[derive(Debug, Clone)]
+pub struct GltfPart {
+    /// The mesh's index in the file's `meshes`.
+    pub mesh: usize,
+    /// The primitive's index in the mesh's `primitives`.
+    pub primitive: usize,
+    /// The mesh's `name`, when it has one.
+    pub name: Option<String>,
+    /// The primitive's `material` index; `None` for the default material
+    /// (white, untextured).
+    pub material: Option<usize>,
+    /// The material's base-colour factor, linear RGBA clamped to 0..=1
+    /// (white without a material).
+    pub base_color: Vec4,
+    /// The primitive's vertices and triangles, untransformed, as
+    /// [`parse_gltf`] reads them: `NORMAL`, `TEXCOORD_0` (`v` flipped) and
+    /// `COLOR_0` where the primitive has them; the colours times
+    /// [`GltfPart::base_color`], or that factor on every vertex where the
+    /// primitive has no `COLOR_0` and the factor is not white; the
+    /// material's base-colour texture (kept even without texture
+    /// coordinates, which a renderer cannot sample it with). Every index is
+    /// in range and every value finite; [`crate::mesh::clean`] makes a
+    /// [`crate::Mesh`] of it.
+    pub raw: RawMesh,
+    /// Model-to-world matrices, one per node that holds the mesh, in scene
+    /// order (depth first, children in order), composed in `f64` from the
+    /// root; at least one. A matrix may mirror (negative determinant): a
+    /// renderer that culls back faces draws such an instance with its
+    /// triangles' winding reversed, as [`parse_gltf`] stores it.
+    pub transforms: Vec<DMat4>,
+}
+
+/// Parses a `.gltf` or `.glb` file into its parts: one [`GltfPart`] per
+/// triangle primitive of every mesh the scene reaches (the same meshes,
+/// nodes and attributes as [`parse_gltf`], in the order of their first
+/// instance, primitives in order), each with its own properties and
+/// texture and the transforms of every node that holds its mesh. A mesh
+/// held by several nodes is read once. Points and lines are skipped with a
+/// note, as in [`parse_gltf`].
+///
+/// `max_triangles` bounds the instances as in [`parse_gltf_with`] (each
+/// instance counted, three times as many vertices), so a file this
+/// accepts merges within the same limit, and the file's counts are
+/// checked before anything is allocated. Every material's base-colour
+/// image is read (each once, shared between parts by clone).
+///
+/// # Errors
+/// As [`parse_gltf_with`], and [`Error::Parse`] naming an image that is
+/// not valid (a data URI that is not base64) of any part.
+///
+/// Cost: O(file size + parts' data); a mesh's data is read once however
+/// many nodes hold it, each further instance costs one matrix.
+pub fn parse_gltf_parts(bytes: &[u8], path: &Path, max_triangles: u64) -> Result<Vec<GltfPart>> {
+    let (root, bin) = parse_container(bytes, path)?;
+    let target = Target::Parts {
+        parts: Vec::new(),
+        of_mesh: HashMap::new(),
+        images: HashMap::new(),
+    };
+    let mut reader = Reader::new(&root, path, bin, max_triangles, target);
+    reader.check_extensions()?;
+    reader.read_scene()?;
+    match reader.target {
+        Target::Parts { parts, .. } => Ok(parts),
+        _ => unreachable!("the reader was made for parts"),
+    }
+}
+
+/// How many parts [`parse_gltf_parts`] would return for the file: the
+/// distinct (mesh, triangle primitive) pairs the scene reaches. Only the
+/// JSON is read (and a `.glb`'s chunks checked): no buffer, accessor or
+/// image, so a file whose data is broken may count and still fail to
+/// parse.
+///
+/// # Errors
+/// [`Error::Parse`] for what the walk over the scene checks: the JSON, the
+/// asset's version, required extensions, scene, node and mesh indices, the
+/// node trees, node transforms and primitive modes.
+///
+/// Cost: O(JSON size + nodes); nothing is allocated per vertex.
+pub fn gltf_part_count(bytes: &[u8], path: &Path) -> Result<usize> {
+    let (root, bin) = parse_container(bytes, path)?;
+    let target = Target::Count {
+        meshes: HashSet::new(),
+        parts: 0,
+    };
+    let mut reader = Reader::new(&root, path, bin, u64::MAX, target);
+    reader.check_extensions()?;
+    reader.read_scene()?;
+    match reader.target {
+        Target::Count { parts, .. } => Ok(parts),
+        _ => unreachable!("the reader was made to count"),
+    }
+}
+
+/// The typed document of a `.gltf` or `.glb` file and its BIN chunk.
+fn parse_container<'a>(bytes: &'a [u8], path: &Path) -> Result<(json::Root, Bin<'a>)> {
+    let is_glb = bytes.starts_with(b"glTF");
+    let (text, bin) = if is_glb {
         split_glb(bytes, path)?
     } else {
         (bytes, None)
     };
-    let root = parse_document(text, path, bytes.starts_with(b"glTF"))?;
-    let mut reader = Reader {
-        root: &root,
-        path,
-        folder: path.parent().map(Path::to_owned).unwrap_or_default(),
-        bin,
-        buffers: (0..root.buffers.len()).map(|_| None).collect(),
-        raw: RawMesh::default(),
-        base_color: None,
-        factors_used: false,
-        instanced_triangles: 0,
-        max_triangles,
-        notes: HashSet::new(),
-    };
-    reader.check_extensions()?;
-    reader.read_scene()?;
-    reader.finish()
+    Ok((parse_document(text, path, is_glb)?, bin))
 }
 
 /// The typed document of the JSON `text`, after the checks the typed model
@@ -596,6 +709,27 @@ struct BaseColor {
     texture: Texture,
 }
 
+/// A primitive's data before it is placed ([`Reader::geometry`]).
+struct Geometry {
+    /// The `POSITION` accessor and its checked layout (read last).
+    pa: usize,
+    positions: Elements,
+    /// `NORMAL`, `TEXCOORD_0` and `COLOR_0` as floats, with their
+    /// components per element, where the primitive has them.
+    streams: [Option<(Vec<f32>, usize)>; 3],
+    triangles: Vec<[u32; 3]>,
+    /// Degenerate strip or fan triangles dropped.
+    degenerate: usize,
+}
+
+/// A primitive's material, checked ([`Reader::material`]).
+struct Material {
+    index: Option<usize>,
+    factor: Vec4,
+    /// The base-colour image, and the texture that names it.
+    image: Option<(usize, usize)>,
+}
+
 /// State of one parse.
 struct Reader<'a> {
     root: &'a json::Root,
@@ -609,14 +743,62 @@ struct Reader<'a> {
     /// Whether some material's base-colour factor is not white.
     factors_used: bool,
     instanced_triangles: u64,
+    /// Vertices of every instance so far (the merged mesh's vertex count).
+    instanced_vertices: u64,
     /// The caller's limit on `instanced_triangles` (and on three times as
     /// many vertices).
     max_triangles: u64,
     /// Notes printed so far (each once, though a mesh is instanced often).
     notes: HashSet<String>,
+    /// What the walk over the scene makes.
+    target: Target,
+}
+
+/// What a [`Reader`] makes of the meshes the scene reaches.
+enum Target {
+    /// One mesh of every instance, transformed ([`parse_gltf`]).
+    Merged,
+    /// A part per triangle primitive of every mesh reached, untransformed,
+    /// with its instances' transforms ([`parse_gltf_parts`]).
+    Parts {
+        parts: Vec<GltfPart>,
+        /// The parts of each mesh read so far, by mesh index.
+        of_mesh: HashMap<usize, Vec<usize>>,
+        /// Base-colour images read so far, by image index.
+        images: HashMap<usize, Option<Texture>>,
+    },
+    /// Only the parts counted, no data read ([`gltf_part_count`]).
+    Count {
+        meshes: HashSet<usize>,
+        parts: usize,
+    },
 }
 
 impl<'a> Reader<'a> {
+    fn new(
+        root: &'a json::Root,
+        path: &'a Path,
+        bin: Bin<'a>,
+        max_triangles: u64,
+        target: Target,
+    ) -> Reader<'a> {
+        Reader {
+            root,
+            path,
+            folder: path.parent().map(Path::to_owned).unwrap_or_default(),
+            bin,
+            buffers: (0..root.buffers.len()).map(|_| None).collect(),
+            raw: RawMesh::default(),
+            base_color: None,
+            factors_used: false,
+            instanced_triangles: 0,
+            instanced_vertices: 0,
+            max_triangles,
+            notes: HashSet::new(),
+            target,
+        }
+    }
+
     fn fail(&self, place: Place, message: String) -> Error {
         Error::Parse {
             file: self.path.to_owned(),
@@ -764,8 +946,8 @@ impl<'a> Reader<'a> {
         ))
     }
 
-    /// Reads every primitive of mesh `m` under `world`; `place` is the node
-    /// (or mesh) that asked for it.
+    /// Reads every primitive of mesh `m` under `world` into the target;
+    /// `place` is the node (or mesh) that asked for it.
     fn read_mesh(&mut self, m: usize, world: DMat4, place: Place) -> Result<()> {
         let root = self.root;
         let Some(mesh) = root.meshes.get(m) else {
@@ -774,8 +956,149 @@ impl<'a> Reader<'a> {
                 format!("mesh {m} does not exist ({} meshes)", root.meshes.len()),
             ));
         };
-        for (p, primitive) in mesh.primitives.iter().enumerate() {
-            self.read_primitive(m, p, primitive, world)?;
+        match &mut self.target {
+            Target::Merged => {
+                for (p, primitive) in mesh.primitives.iter().enumerate() {
+                    self.read_primitive(m, p, primitive, world)?;
+                }
+            }
+            Target::Parts { of_mesh, .. } => match of_mesh.get(&m) {
+                Some(parts) => {
+                    let parts = parts.clone();
+                    self.instance_parts(&parts, world)?;
+                }
+                None => {
+                    let mut parts = Vec::with_capacity(mesh.primitives.len());
+                    for (p, primitive) in mesh.primitives.iter().enumerate() {
+                        if let Some(part) = self.read_part(m, p, primitive, world)? {
+                            parts.push(part);
+                        }
+                    }
+                    if let Target::Parts { of_mesh, .. } = &mut self.target {
+                        of_mesh.insert(m, parts);
+                    }
+                }
+            },
+            Target::Count { meshes, parts } => {
+                if meshes.insert(m) {
+                    for (p, primitive) in mesh.primitives.iter().enumerate() {
+                        let place = Place::element(&format!("mesh {m} primitive"), p as u64);
+                        let Checked::Valid(mode) = primitive.mode else {
+                            return Err(self.fail(place, "unknown primitive mode".into()));
+                        };
+                        if is_triangles(mode) {
+                            *parts += 1;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A primitive's attributes and triangles, read and checked, the
+    /// instance counted against the limits; `None` (with a note) for points
+    /// and lines. The positions are left unread: [`Reader::read_primitive`]
+    /// reads the material first.
+    fn geometry(
+        &mut self,
+        m: usize,
+        p: usize,
+        primitive: &json::mesh::Primitive,
+        place: &Place,
+    ) -> Result<Option<Geometry>> {
+        let Checked::Valid(mode) = primitive.mode else {
+            return Err(self.fail(place.clone(), "unknown primitive mode".into()));
+        };
+        if !is_triangles(mode) {
+            let root = self.root;
+            let name = root.meshes[m].name.as_deref().unwrap_or("");
+            self.note(format!(
+                "mesh {m} {name:?} primitive {p} draws {mode:?}, not triangles: skipped"
+            ));
+            return Ok(None);
+        }
+        let attribute = |semantic: Semantic| {
+            primitive
+                .attributes
+                .get(&Checked::Valid(semantic))
+                .map(|a| a.value())
+        };
+        let Some(pa) = attribute(Semantic::Positions) else {
+            return Err(self.fail(place.clone(), "no POSITION attribute".into()));
+        };
+        let positions = self.elements(pa, &[3], "POSITION", place)?;
+        let count = positions.count;
+        self.count_vertices(count, place)?;
+        let mut streams = [None, None, None];
+        for (slot, (semantic, dims, name)) in [
+            (Semantic::Normals, &[3][..], "NORMAL"),
+            (Semantic::TexCoords(0), &[2][..], "TEXCOORD_0"),
+            (Semantic::Colors(0), &[3, 4][..], "COLOR_0"),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if let Some(a) = attribute(semantic) {
+                let e = self.elements(a, dims, name, place)?;
+                if e.count != count {
+                    return Err(self.fail(
+                        place.clone(),
+                        format!(
+                            "{name} (accessor {a}) has {} elements, POSITION (accessor {pa}) {count}",
+                            e.count
+                        ),
+                    ));
+                }
+                streams[slot] = Some((self.floats(a, &e)?, e.dims));
+            }
+        }
+        let indices = match primitive.indices {
+            Some(a) => self.indices(a.value(), count, place)?,
+            None => (0..count as u32).collect(),
+        };
+        let (triangles, degenerate) = self.triangles(mode, &indices, place)?;
+        self.count_triangles(triangles.len(), place)?;
+        Ok(Some(Geometry {
+            pa,
+            positions,
+            streams,
+            triangles,
+            degenerate,
+        }))
+    }
+
+    /// Counts `count` more instanced vertices, refused past three times
+    /// the triangle limit.
+    fn count_vertices(&mut self, count: usize, place: &Place) -> Result<()> {
+        let max_vertices = self.max_triangles.saturating_mul(3);
+        if self.instanced_vertices + count as u64 > max_vertices {
+            return Err(self.fail(
+                place.clone(),
+                format!(
+                    "the scene's instances ask for more than {max_vertices} vertices, three \
+                     times the limit of {} triangles{}",
+                    self.max_triangles,
+                    super::RAISE_LIMIT
+                ),
+            ));
+        }
+        self.instanced_vertices += count as u64;
+        Ok(())
+    }
+
+    /// Counts `count` more instanced triangles, refused past the limit.
+    fn count_triangles(&mut self, count: usize, place: &Place) -> Result<()> {
+        self.instanced_triangles += count as u64;
+        if self.instanced_triangles > self.max_triangles {
+            return Err(self.fail(
+                place.clone(),
+                format!(
+                    "the scene's instances ask for more than {} triangles, the limit{}",
+                    self.max_triangles,
+                    super::RAISE_LIMIT
+                ),
+            ));
         }
         Ok(())
     }
@@ -788,83 +1111,19 @@ impl<'a> Reader<'a> {
         world: DMat4,
     ) -> Result<()> {
         let place = Place::element(&format!("mesh {m} primitive"), p as u64);
-        let Checked::Valid(mode) = primitive.mode else {
-            return Err(self.fail(place, "unknown primitive mode".into()));
-        };
-        if !matches!(
-            mode,
-            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-        ) {
-            let root = self.root;
-            let name = root.meshes[m].name.as_deref().unwrap_or("");
-            self.note(format!(
-                "mesh {m} {name:?} primitive {p} draws {mode:?}, not triangles: skipped"
-            ));
-            return Ok(());
-        }
-        let attribute = |semantic: Semantic| {
-            primitive
-                .attributes
-                .get(&Checked::Valid(semantic))
-                .map(|a| a.value())
-        };
-        let Some(pa) = attribute(Semantic::Positions) else {
-            return Err(self.fail(place, "no POSITION attribute".into()));
-        };
-        let positions = self.elements(pa, &[3], "POSITION", &place)?;
-        let count = positions.count;
         let before = self.raw.positions.len();
-        let max_vertices = self.max_triangles.saturating_mul(3);
-        if before as u64 + count as u64 > max_vertices {
-            return Err(self.fail(
-                place,
-                format!(
-                    "the scene's instances ask for more than {max_vertices} vertices, three \
-                     times the limit of {} triangles{}",
-                    self.max_triangles,
-                    super::RAISE_LIMIT
-                ),
-            ));
-        }
-        let mut streams = [None, None, None];
-        for (slot, (semantic, dims, name)) in [
-            (Semantic::Normals, &[3][..], "NORMAL"),
-            (Semantic::TexCoords(0), &[2][..], "TEXCOORD_0"),
-            (Semantic::Colors(0), &[3, 4][..], "COLOR_0"),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            if let Some(a) = attribute(semantic) {
-                let e = self.elements(a, dims, name, &place)?;
-                if e.count != count {
-                    return Err(self.fail(
-                        place,
-                        format!(
-                            "{name} (accessor {a}) has {} elements, POSITION (accessor {pa}) {count}",
-                            e.count
-                        ),
-                    ));
-                }
-                streams[slot] = Some((self.floats(a, &e)?, e.dims));
-            }
-        }
-        let indices = match primitive.indices {
-            Some(a) => self.indices(a.value(), count, &place)?,
-            None => (0..count as u32).collect(),
+        let Some(geometry) = self.geometry(m, p, primitive, &place)? else {
+            return Ok(());
         };
-        let triangles = self.triangles(mode, &indices, &place)?;
-        self.instanced_triangles += triangles.len() as u64;
-        if self.instanced_triangles > self.max_triangles {
-            return Err(self.fail(
-                place,
-                format!(
-                    "the scene's instances ask for more than {} triangles, the limit{}",
-                    self.max_triangles,
-                    super::RAISE_LIMIT
-                ),
-            ));
-        }
+        let Geometry {
+            pa,
+            positions,
+            streams,
+            triangles,
+            degenerate,
+        } = geometry;
+        let count = positions.count;
+        self.raw.degenerate_in_source += degenerate;
         let factor = self.read_material(primitive, &place, streams[1].is_some())?;
         let positions = self.floats(pa, &positions)?;
 
@@ -906,21 +1165,10 @@ impl<'a> Reader<'a> {
                 .collect::<Vec<_>>()
         });
         extend(&mut properties.normals, before, count, normals, Vec3::ZERO);
-        let uvs = uvs.map(|(t, _)| {
-            t.chunks_exact(2)
-                .map(|t| Vec2::new(t[0], 1.0 - t[1]))
-                .collect::<Vec<_>>()
-        });
+        let uvs = uvs.map(|(t, _)| flip_uvs(&t));
         extend(&mut properties.uvs, before, count, uvs, Vec2::ZERO);
         let colors = match colors {
-            Some((c, dims)) => Some(
-                c.chunks_exact(dims)
-                    .map(|c| {
-                        let alpha = if dims == 4 { c[3] } else { 1.0 };
-                        Vec4::new(c[0], c[1], c[2], alpha) * factor
-                    })
-                    .collect::<Vec<_>>(),
-            ),
+            Some((c, dims)) => Some(colors_times(&c, dims, factor)),
             None if self.factors_used => Some(vec![factor; count]),
             None => None,
         };
@@ -938,18 +1186,119 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
+    /// Reads primitive `p` of mesh `m` as a new part placed at `world`;
+    /// returns its index in the parts, `None` for points and lines.
+    fn read_part(
+        &mut self,
+        m: usize,
+        p: usize,
+        primitive: &json::mesh::Primitive,
+        world: DMat4,
+    ) -> Result<Option<usize>> {
+        let place = Place::element(&format!("mesh {m} primitive"), p as u64);
+        let Some(geometry) = self.geometry(m, p, primitive, &place)? else {
+            return Ok(None);
+        };
+        let Geometry {
+            pa,
+            positions,
+            streams,
+            triangles,
+            degenerate,
+        } = geometry;
+        let has_uvs = streams[1].is_some();
+        let material = self.material(primitive, &place, has_uvs)?;
+        let texture = match material.image {
+            Some((image, texture)) => self.part_image(image, texture)?,
+            None => None,
+        };
+        let factor = material.factor;
+        let positions = self.floats(pa, &positions)?;
+        let count = positions.len() / 3;
+        let [normals, uvs, colors] = streams;
+        let properties = crate::mesh::Properties {
+            normals: normals.map(|(n, _)| n.chunks_exact(3).map(Vec3::from_slice).collect()),
+            uvs: uvs.map(|(t, _)| flip_uvs(&t)),
+            colors: match colors {
+                Some((c, dims)) => Some(colors_times(&c, dims, factor)),
+                None if factor != Vec4::ONE => Some(vec![factor; count]),
+                None => None,
+            },
+            position_ids: Vec::new(),
+            texture,
+        };
+        let raw = RawMesh {
+            positions: positions.chunks_exact(3).map(Vec3::from_slice).collect(),
+            triangles,
+            degenerate_in_source: degenerate,
+            properties,
+        };
+        let Target::Parts { parts, .. } = &mut self.target else {
+            unreachable!("parts are read for the parts target");
+        };
+        parts.push(GltfPart {
+            mesh: m,
+            primitive: p,
+            name: self.root.meshes[m].name.clone(),
+            material: material.index,
+            base_color: factor,
+            raw,
+            transforms: vec![world],
+        });
+        Ok(Some(parts.len() - 1))
+    }
+
+    /// One more instance, at `world`, of the mesh whose parts (read before)
+    /// are `of_mesh`: counted against the limits as [`parse_gltf`] would
+    /// count its copy.
+    fn instance_parts(&mut self, of_mesh: &[usize], world: DMat4) -> Result<()> {
+        for &i in of_mesh {
+            let Target::Parts { parts, .. } = &self.target else {
+                unreachable!("parts are instanced for the parts target");
+            };
+            let part = &parts[i];
+            let place = Place::element(
+                &format!("mesh {} primitive", part.mesh),
+                part.primitive as u64,
+            );
+            let (vertices, triangles) = (part.raw.positions.len(), part.raw.triangles.len());
+            self.count_vertices(vertices, &place)?;
+            self.count_triangles(triangles, &place)?;
+            if let Target::Parts { parts, .. } = &mut self.target {
+                parts[i].transforms.push(world);
+            }
+        }
+        Ok(())
+    }
+
+    /// The texture of image `i` for a part (read once, then cloned), from
+    /// material texture `texture`.
+    fn part_image(&mut self, i: usize, texture: usize) -> Result<Option<Texture>> {
+        if let Target::Parts { images, .. } = &self.target {
+            if let Some(read) = images.get(&i) {
+                return Ok(read.clone());
+            }
+        }
+        let read = self.image(i, Place::element("texture", texture as u64))?;
+        if let Target::Parts { images, .. } = &mut self.target {
+            images.insert(i, read.clone());
+        }
+        Ok(read)
+    }
+
     /// The primitive's triangles from its index list, by mode (the
     /// specification's topology types): strip triangle `i` is
     /// `(i, i + 1 + i % 2, i + 2 - i % 2)`, fan triangle `i` is
-    /// `(i + 1, i + 2, 0)`. Degenerate strip and fan triangles (a strip's
-    /// joins) are counted in [`RawMesh::degenerate_in_source`].
-    fn triangles(&mut self, mode: Mode, ix: &[u32], place: &Place) -> Result<Vec<[u32; 3]>> {
+    /// `(i + 1, i + 2, 0)`; and the degenerate strip and fan triangles (a
+    /// strip's joins) dropped, for [`RawMesh::degenerate_in_source`].
+    fn triangles(&self, mode: Mode, ix: &[u32], place: &Place) -> Result<(Vec<[u32; 3]>, usize)> {
         let n = ix.len();
         let mut out = Vec::with_capacity(if mode == Mode::Triangles {
             n / 3
         } else {
             n.saturating_sub(2)
         });
+        let mut degenerate = 0;
         match mode {
             Mode::Triangles => {
                 if n % 3 != 0 {
@@ -968,7 +1317,7 @@ impl<'a> Reader<'a> {
                         [ix[i], ix[i + 1 + i % 2], ix[i + 2 - i % 2]]
                     };
                     if crate::mesh::is_degenerate(t) {
-                        self.raw.degenerate_in_source += 1;
+                        degenerate += 1;
                     } else {
                         out.push(t);
                     }
@@ -976,20 +1325,26 @@ impl<'a> Reader<'a> {
             }
             _ => unreachable!("only triangle modes reach here"),
         }
-        Ok(out)
+        Ok((out, degenerate))
     }
 
-    /// The primitive material's base-colour factor; chooses the texture
-    /// when none is chosen yet, notes one that differs.
-    fn read_material(
+    /// The primitive's material, checked: its index, base-colour factor
+    /// (clamped to 0..=1) and base-colour image with the texture naming it;
+    /// notes a texture set other than 0, and a texture without
+    /// `TEXCOORD_0` (`has_uvs`).
+    fn material(
         &mut self,
         primitive: &json::mesh::Primitive,
         place: &Place,
         has_uvs: bool,
-    ) -> Result<Vec4> {
+    ) -> Result<Material> {
         let root = self.root;
         let Some(mi) = primitive.material.map(|m| m.value()) else {
-            return Ok(Vec4::ONE);
+            return Ok(Material {
+                index: None,
+                factor: Vec4::ONE,
+                image: None,
+            });
         };
         let Some(material) = root.materials.get(mi) else {
             return Err(self.fail(
@@ -1009,17 +1364,12 @@ impl<'a> Reader<'a> {
             ));
         }
         let factor = factor.clamp(Vec4::ZERO, Vec4::ONE);
-        if factor != Vec4::ONE && !self.factors_used {
-            // Colours so far were white.
-            self.factors_used = true;
-            let n = self.raw.positions.len();
-            self.raw
-                .properties
-                .colors
-                .get_or_insert_with(|| vec![Vec4::ONE; n]);
-        }
         let Some(info) = &pbr.base_color_texture else {
-            return Ok(factor);
+            return Ok(Material {
+                index: Some(mi),
+                factor,
+                image: None,
+            });
         };
         let ti = info.index.value();
         let Some(texture) = root.textures.get(ti) else {
@@ -1044,6 +1394,35 @@ impl<'a> Reader<'a> {
                  are (0, 0)"
             ));
         }
+        Ok(Material {
+            index: Some(mi),
+            factor,
+            image: Some((image, ti)),
+        })
+    }
+
+    /// The primitive material's base-colour factor, for the merged mesh;
+    /// chooses the texture when none is chosen yet, notes one that differs.
+    fn read_material(
+        &mut self,
+        primitive: &json::mesh::Primitive,
+        place: &Place,
+        has_uvs: bool,
+    ) -> Result<Vec4> {
+        let material = self.material(primitive, place, has_uvs)?;
+        let factor = material.factor;
+        if factor != Vec4::ONE && !self.factors_used {
+            // Colours so far were white.
+            self.factors_used = true;
+            let n = self.raw.positions.len();
+            self.raw
+                .properties
+                .colors
+                .get_or_insert_with(|| vec![Vec4::ONE; n]);
+        }
+        let (Some((image, ti)), Some(mi)) = (material.image, material.index) else {
+            return Ok(factor);
+        };
         match &self.base_color {
             None => {
                 if let Some(texture) = self.image(image, Place::element("texture", ti as u64))? {
@@ -1563,6 +1942,32 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// Whether primitives of `mode` are read (triangles, strips and fans).
+fn is_triangles(mode: Mode) -> bool {
+    matches!(
+        mode,
+        Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+    )
+}
+
+/// glTF texture coordinates (`v` down the image) as the mesh's (`v` up).
+fn flip_uvs(t: &[f32]) -> Vec<Vec2> {
+    t.chunks_exact(2)
+        .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+        .collect()
+}
+
+/// `COLOR_0` values of `dims` (3 or 4) components as RGBA (alpha 1 for
+/// RGB), times the material's `factor`.
+fn colors_times(c: &[f32], dims: usize, factor: Vec4) -> Vec<Vec4> {
+    c.chunks_exact(dims)
+        .map(|c| {
+            let alpha = if dims == 4 { c[3] } else { 1.0 };
+            Vec4::new(c[0], c[1], c[2], alpha) * factor
+        })
+        .collect()
+}
+
 /// Appends `count` values of a stream for vertices `before..`: `values`
 /// when the primitive has them (the stream created with `neutral` for the
 /// earlier vertices if it did not exist), else `neutral` when the stream
@@ -1738,4 +2143,233 @@ pub(super) fn decode_uri(uri: &str) -> std::result::Result<PathBuf, String> {
     String::from_utf8(bytes)
         .map(PathBuf::from)
         .map_err(|_| format!("URI {uri:?} decodes to bytes that are not UTF-8"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// Standard base64 with padding.
+    fn base64(bytes: &[u8]) -> String {
+        const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut out = String::new();
+        for group in bytes.chunks(3) {
+            let b = [
+                group[0],
+                *group.get(1).unwrap_or(&0),
+                *group.get(2).unwrap_or(&0),
+            ];
+            let n = u32::from(b[0]) << 16 | u32::from(b[1]) << 8 | u32::from(b[2]);
+            for k in 0..4 {
+                if k <= group.len() {
+                    out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize] as char);
+                } else {
+                    out.push('=');
+                }
+            }
+        }
+        out
+    }
+
+    //  3 - 2
+    //  | / |   a unit quad in z = 0, counter-clockwise seen from +z;
+    //  0 - 1   texture coordinates (x, y) in glTF's (v down).
+    //
+    //  4        a triangle whose primitive draws points (skipped).
+    //
+    // Mesh 0: the quad with TEXCOORD_0 and material 0 (image 0); mesh 1:
+    // the quad without, material 1 (a base-colour factor, no texture);
+    // mesh 2: the quad with material 2 (image 1) and the point primitive.
+    // Nodes: 0 (mesh 0, x + 3); 1 (no mesh, scale -1 in x, then z + 5)
+    // with children 2 (mesh 1) and 3 (mesh 0, y + 2); 4 (mesh 2).
+    fn scene_file() -> Vec<u8> {
+        let floats: Vec<f32> = vec![
+            0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0., // positions
+            0., 0., 1., 0., 1., 1., 0., 1., // texture coordinates
+        ];
+        let mut bin: Vec<u8> = floats.iter().flat_map(|x| x.to_le_bytes()).collect();
+        bin.extend([0u16, 1, 2, 0, 2, 3].iter().flat_map(|x| x.to_le_bytes()));
+        let body = json!({
+            "asset": { "version": "2.0" },
+            "buffers": [{
+                "byteLength": bin.len(),
+                "uri": format!("data:application/octet-stream;base64,{}", base64(&bin)),
+            }],
+            "bufferViews": [
+                { "buffer": 0, "byteOffset": 0, "byteLength": 48 },
+                { "buffer": 0, "byteOffset": 48, "byteLength": 32 },
+                { "buffer": 0, "byteOffset": 80, "byteLength": 12 },
+            ],
+            "accessors": [
+                { "bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 4 },
+                { "bufferView": 1, "componentType": 5126, "type": "VEC2", "count": 4 },
+                { "bufferView": 2, "componentType": 5123, "type": "SCALAR", "count": 6 },
+            ],
+            "images": [
+                { "uri": format!("data:image/png;base64,{}", base64(b"first")) },
+                { "uri": format!("data:image/png;base64,{}", base64(b"second")) },
+            ],
+            "textures": [{ "source": 0 }, { "source": 1 }],
+            "materials": [
+                { "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } },
+                { "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.25, 1.0, 1.0] } },
+                { "pbrMetallicRoughness": { "baseColorTexture": { "index": 1 } } },
+            ],
+            "meshes": [
+                { "name": "a", "primitives": [
+                    { "attributes": { "POSITION": 0, "TEXCOORD_0": 1 }, "indices": 2, "material": 0 },
+                ] },
+                { "primitives": [{ "attributes": { "POSITION": 0 }, "indices": 2, "material": 1 }] },
+                { "primitives": [
+                    { "attributes": { "POSITION": 0 }, "mode": 0 },
+                    { "attributes": { "POSITION": 0, "TEXCOORD_0": 1 }, "indices": 2, "material": 2 },
+                ] },
+            ],
+            "nodes": [
+                { "mesh": 0, "translation": [3.0, 0.0, 0.0] },
+                { "children": [2, 3], "translation": [0.0, 0.0, 5.0], "scale": [-1.0, 1.0, 1.0] },
+                { "mesh": 1 },
+                { "mesh": 0, "translation": [0.0, 2.0, 0.0] },
+                { "mesh": 2 },
+            ],
+            "scenes": [{ "nodes": [0, 1, 4] }],
+        });
+        serde_json::to_vec(&body).unwrap()
+    }
+
+    /// Three parts in the order of their meshes' first instances, each
+    /// untransformed with its own texture or factor; mesh 0 once with its
+    /// two nodes' matrices; the merged mesh is the parts placed at their
+    /// transforms, in scene order, mirrored copies' winding flipped.
+    #[test]
+    fn parts_keep_their_textures_and_list_their_instances() {
+        let file = scene_file();
+        let path = Path::new("scene.gltf");
+        let parts = parse_gltf_parts(&file, path, 1000).unwrap();
+        assert_eq!(gltf_part_count(&file, path).unwrap(), 3);
+        let which: Vec<_> = parts.iter().map(|p| (p.mesh, p.primitive)).collect();
+        assert_eq!(which, [(0, 0), (1, 0), (2, 1)]);
+        let quad = [
+            Vec3::ZERO,
+            Vec3::new(1., 0., 0.),
+            Vec3::new(1., 1., 0.),
+            Vec3::new(0., 1., 0.),
+        ];
+        for part in &parts {
+            assert_eq!(part.raw.positions, quad);
+            assert_eq!(part.raw.triangles, [[0, 1, 2], [0, 2, 3]]);
+            assert_eq!(part.raw.properties.normals, None);
+        }
+        let png = |b: &[u8]| {
+            Some(Texture::Embedded {
+                mime: "image/png".into(),
+                bytes: b.to_vec(),
+            })
+        };
+        let (a, b, c) = (&parts[0], &parts[1], &parts[2]);
+        assert_eq!(a.name.as_deref(), Some("a"));
+        assert_eq!(
+            (a.material, b.material, c.material),
+            (Some(0), Some(1), Some(2))
+        );
+        assert_eq!(a.raw.properties.texture, png(b"first"));
+        assert_eq!(c.raw.properties.texture, png(b"second"));
+        assert_eq!(b.raw.properties.texture, None);
+        let uvs = [
+            Vec2::new(0., 1.),
+            Vec2::new(1., 1.),
+            Vec2::new(1., 0.),
+            Vec2::new(0., 0.),
+        ];
+        assert_eq!(a.raw.properties.uvs.as_deref(), Some(&uvs[..]));
+        assert_eq!(b.raw.properties.uvs, None);
+        // A factor that is not white colours every vertex of its part
+        // only; white ones add no colours.
+        let factor = Vec4::new(0.5, 0.25, 1.0, 1.0);
+        assert_eq!(b.base_color, factor);
+        assert_eq!(b.raw.properties.colors, Some(vec![factor; 4]));
+        assert_eq!(
+            (a.base_color, a.raw.properties.colors.as_ref()),
+            (Vec4::ONE, None)
+        );
+
+        let mirror = DMat4::from_translation(DVec3::new(0., 0., 5.))
+            * DMat4::from_scale(DVec3::new(-1., 1., 1.));
+        let under = mirror * DMat4::from_translation(DVec3::new(0., 2., 0.));
+        assert_eq!(
+            a.transforms,
+            [DMat4::from_translation(DVec3::new(3., 0., 0.)), under]
+        );
+        assert_eq!(b.transforms, [mirror]);
+        assert_eq!(c.transforms, [DMat4::IDENTITY]);
+
+        // The merged mesh: instances in scene order (node 0, 2, 3, 4).
+        let merged = parse_gltf(&file, path).unwrap();
+        let instances = [(a, 0), (b, 0), (a, 1), (c, 0)];
+        assert_eq!(merged.positions.len(), 4 * instances.len());
+        for (k, (part, t)) in instances.iter().enumerate() {
+            let world = part.transforms[*t];
+            let placed: Vec<Vec3> = part
+                .raw
+                .positions
+                .iter()
+                .map(|p| world.transform_point3(p.as_dvec3()).as_vec3())
+                .collect();
+            assert_eq!(
+                merged.positions[4 * k..4 * k + 4],
+                placed[..],
+                "instance {k}"
+            );
+            let flip = world.determinant() < 0.0;
+            for (i, t) in part.raw.triangles.iter().enumerate() {
+                let t = t.map(|v| v + 4 * k as u32);
+                let want = if flip { [t[0], t[2], t[1]] } else { t };
+                assert_eq!(merged.triangles[2 * k + i], want, "instance {k}");
+            }
+        }
+        // One texture kept: the first in scene order.
+        assert_eq!(merged.properties.texture, png(b"first"));
+    }
+
+    /// The limit counts every instance, as the merged mesh's copies: 8
+    /// triangles (mesh 0 twice, meshes 1 and 2) pass with 8 and not with 7,
+    /// refused at the same primitive with the same message either way.
+    #[test]
+    fn parts_are_bounded_by_their_instances_as_the_merged_mesh() {
+        let file = scene_file();
+        let path = Path::new("scene.gltf");
+        assert!(parse_gltf_parts(&file, path, 8).is_ok());
+        let parts = parse_gltf_parts(&file, path, 7).unwrap_err().to_string();
+        let merged = parse_gltf_with(&file, path, 7).unwrap_err().to_string();
+        assert_eq!(parts, merged);
+        assert!(parts.contains("mesh 2 primitive 1"), "{parts}");
+        assert!(parts.contains("more than 7 triangles"), "{parts}");
+        // With 5, at mesh 0's second instance (node 3), which reads no
+        // data again but counts.
+        let parts = parse_gltf_parts(&file, path, 5).unwrap_err().to_string();
+        assert_eq!(
+            parts,
+            parse_gltf_with(&file, path, 5).unwrap_err().to_string()
+        );
+        assert!(parts.contains("mesh 0 primitive 0"), "{parts}");
+    }
+
+    /// The count reads no buffer: a file whose buffer is not there still
+    /// counts its parts, and parsing it names the buffer.
+    #[test]
+    fn counting_parts_reads_only_the_json() {
+        let mut value: serde_json::Value = serde_json::from_slice(&scene_file()).unwrap();
+        value["buffers"][0]["uri"] = json!("missing.bin");
+        let file = serde_json::to_vec(&value).unwrap();
+        let path = Path::new("/nonexistent/scene.gltf");
+        assert_eq!(gltf_part_count(&file, path).unwrap(), 3);
+        let e = parse_gltf_parts(&file, path, 1000).unwrap_err();
+        assert!(e.to_string().contains("missing.bin"), "{e}");
+        // Structure is checked: a node out of range is an error.
+        value["scenes"][0]["nodes"] = json!([0, 9]);
+        let file = serde_json::to_vec(&value).unwrap();
+        let e = gltf_part_count(&file, path).unwrap_err().to_string();
+        assert!(e.contains("node 9 does not exist"), "{e}");
+    }
 }

@@ -1,6 +1,7 @@
 //! glTF 2.0 writer (feature `gltf`): one mesh, one indexed triangle-list
 //! primitive, as a `.glb` or as a `.gltf` with its buffer in a sibling
-//! `.bin`. The reader is [`super::parse_gltf`].
+//! `.bin`; the pieces ([`Document`]) are shared with the LoD chain writer
+//! ([`super::lod_chain`]). The reader is [`super::parse_gltf`].
 //!
 //! Layout (glTF 2.0, binary data storage and the GLB format): one buffer of tightly packed, 4-byte
 //! aligned views in the order indices, `POSITION` (with the `min`/`max` the
@@ -12,9 +13,20 @@
 //! fixed and small, and the reader's tests parse every written file back
 //! with the `gltf` crate's full validation.
 //!
+//! **The texture.** A `.glb` is one self-contained file: a
+//! [`Texture::File`] is read and its bytes embedded (a file that cannot be
+//! read is an error naming it; loading already drops, with a warning,
+//! textures that are missing). A `.gltf` refers to a texture file by a
+//! relative URI rather than copying it (the image stays one file, and the
+//! `.gltf` is meant to sit beside its assets); embedded bytes go into its
+//! `.bin`. The material is unlit-looking PBR: base-colour texture,
+//! metallic 0, roughness 1.
+//!
 //! What is lost: position ids (glTF has no seams; weld on load merges
-//! bit-identical positions again); zero normals are written as they are,
-//! which glTF validators report (glTF normals are unit length).
+//! bit-identical positions again). A zero normal (the mesh's "no normal")
+//! is written as the area-weighted normal of the triangles around its
+//! point, or `+z` where they have no area: glTF normals are unit length,
+//! and validators refuse zero ones.
 //!
 //! The `v` flip `1 - v` is exact for `v` in `[0.5, 1]` and for every `v`
 //! that is a multiple of 2^-24 in `[0, 1]` (any texel corner of an image
@@ -23,8 +35,9 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, Texture};
+use glam::Vec3;
 use serde_json::{json, Value};
-use std::path::{Component, Path};
+use std::path::Path;
 
 /// glTF's `ARRAY_BUFFER` and `ELEMENT_ARRAY_BUFFER` targets, `FLOAT`,
 /// `UNSIGNED_SHORT` and `UNSIGNED_INT` component types, `TRIANGLES` mode.
@@ -37,11 +50,10 @@ const TRIANGLES: u32 = 4;
 
 /// Writes `mesh` as glTF 2.0 to `path`: a single binary `.glb`, or a
 /// `.gltf` JSON file with its buffer beside it as `<stem>.bin`, chosen by
-/// the extension (see the module docs for the layout). The base-colour
-/// texture goes into the `.glb` as a buffer view (a [`Texture::File`] is
-/// read for that); a `.gltf` refers to a file by a relative URI and holds
-/// embedded bytes in its buffer. The mesh is expected to satisfy
-/// [`Mesh::validate`].
+/// the extension (see the module docs for the layout and the texture).
+/// Every vertex of `mesh` is written in its order; the mesh is expected to
+/// satisfy [`Mesh::validate`] (so it holds only the vertices its triangles
+/// use).
 ///
 /// # Errors
 /// [`Error::InvalidArgument`] for another extension, a mesh without
@@ -53,95 +65,150 @@ const TRIANGLES: u32 = 4;
 /// Cost: O(V + T); the buffer is built in memory (about 52 bytes per vertex
 /// with every property, 12 per triangle) before it is written.
 pub fn save_gltf(mesh: &Mesh, path: &Path) -> Result<()> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let binary = match ext.as_deref() {
-        Some("glb") => true,
-        Some("gltf") => false,
-        _ => {
-            return Err(Error::InvalidArgument(format!(
-                "{}: a glTF file is named .glb or .gltf",
-                path.display()
-            )))
-        }
-    };
-    if mesh.triangles.is_empty() {
-        return Err(Error::InvalidArgument(format!(
-            "{}: a mesh without triangles cannot be written as glTF (accessors hold at least one element)",
-            path.display()
-        )));
-    }
-    debug_assert!(mesh.validate().is_ok(), "save_gltf: {:?}", mesh.validate());
+    let binary = is_binary(path)?;
     let mut out = Document::default();
-    let properties = &mesh.properties;
-
-    let corners = mesh.triangles.iter().flatten();
-    let (bytes, component) = if mesh.positions.len() > 65535 {
-        let bytes = corners.flat_map(|i| i.to_le_bytes()).collect();
-        (bytes, UNSIGNED_INT)
-    } else {
-        let bytes = corners.flat_map(|&i| (i as u16).to_le_bytes()).collect();
-        (bytes, UNSIGNED_SHORT)
-    };
-    let count = mesh.triangles.len() * 3;
-    let indices = out.accessor(bytes, ELEMENT_ARRAY_BUFFER, component, "SCALAR", count);
-    let floats = |values: &mut dyn Iterator<Item = f32>| -> Vec<u8> {
-        values.flat_map(f32::to_le_bytes).collect()
-    };
-    let mut attributes = serde_json::Map::new();
-    let n = mesh.positions.len();
-    let position = out.accessor(
-        floats(&mut mesh.positions.iter().flat_map(|p| p.to_array())),
-        ARRAY_BUFFER,
-        FLOAT,
-        "VEC3",
-        n,
-    );
-    let (lo, hi) = crate::mesh::bounds_of(&mesh.positions).unwrap_or_default();
-    out.accessors[position]["min"] = json!(lo.to_array());
-    out.accessors[position]["max"] = json!(hi.to_array());
-    attributes.insert("POSITION".into(), json!(position));
-    if let Some(normals) = &properties.normals {
-        let a = out.accessor(
-            floats(&mut normals.iter().flat_map(|v| v.to_array())),
-            ARRAY_BUFFER,
-            FLOAT,
-            "VEC3",
-            n,
-        );
-        attributes.insert("NORMAL".into(), json!(a));
-    }
-    if let Some(uvs) = &properties.uvs {
-        let a = out.accessor(
-            floats(&mut uvs.iter().flat_map(|t| [t.x, 1.0 - t.y])),
-            ARRAY_BUFFER,
-            FLOAT,
-            "VEC2",
-            n,
-        );
-        attributes.insert("TEXCOORD_0".into(), json!(a));
-    }
-    if let Some(colors) = &properties.colors {
-        let a = out.accessor(
-            floats(&mut colors.iter().flat_map(|c| c.to_array())),
-            ARRAY_BUFFER,
-            FLOAT,
-            "VEC4",
-            n,
-        );
-        attributes.insert("COLOR_0".into(), json!(a));
-    }
-    let mut primitive = json!({ "attributes": attributes, "indices": indices, "mode": TRIANGLES });
+    let mut primitive = out.primitive(mesh, path)?;
     let mut root = json!({
         "asset": { "version": "2.0", "generator": "mts" },
         "scene": 0,
         "scenes": [{ "nodes": [0] }],
         "nodes": [{ "mesh": 0 }],
     });
-    if let Some(texture) = &properties.texture {
-        let image = out.image(texture, binary, path)?;
+    if let Some(texture) = &mesh.properties.texture {
+        out.material(&mut root, texture, binary, path)?;
+        primitive["material"] = json!(0);
+    }
+    root["meshes"] = json!([{ "primitives": [primitive] }]);
+    out.write(root, binary, path)
+}
+
+/// Whether `path` names a `.glb` (binary) or a `.gltf`.
+///
+/// # Errors
+/// [`Error::InvalidArgument`] for another extension.
+pub(super) fn is_binary(path: &Path) -> Result<bool> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("glb") => Ok(true),
+        Some("gltf") => Ok(false),
+        _ => Err(Error::InvalidArgument(format!(
+            "{}: a glTF file is named .glb or .gltf",
+            path.display()
+        ))),
+    }
+}
+
+/// The buffer and the views and accessors into it, as they are built.
+#[derive(Default)]
+pub(super) struct Document {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Document {
+    /// The triangle-list primitive of `mesh` (indices and every attribute
+    /// it has; no material), its data appended to the buffer. `path` names
+    /// the output in errors.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for a mesh without triangles.
+    pub(super) fn primitive(&mut self, mesh: &Mesh, path: &Path) -> Result<Value> {
+        if mesh.triangles.is_empty() {
+            return Err(Error::InvalidArgument(format!(
+                "{}: a mesh without triangles cannot be written as glTF (accessors hold at least one element)",
+                path.display()
+            )));
+        }
+        debug_assert!(
+            mesh.validate().is_ok(),
+            "glTF writer: {:?}",
+            mesh.validate()
+        );
+        let properties = &mesh.properties;
+        let corners = mesh.triangles.iter().flatten();
+        let (bytes, component) = if mesh.positions.len() > 65535 {
+            let bytes = corners.flat_map(|i| i.to_le_bytes()).collect();
+            (bytes, UNSIGNED_INT)
+        } else {
+            let bytes = corners.flat_map(|&i| (i as u16).to_le_bytes()).collect();
+            (bytes, UNSIGNED_SHORT)
+        };
+        let count = mesh.triangles.len() * 3;
+        let indices = self.accessor(bytes, ELEMENT_ARRAY_BUFFER, component, "SCALAR", count);
+        let floats = |values: &mut dyn Iterator<Item = f32>| -> Vec<u8> {
+            values.flat_map(f32::to_le_bytes).collect()
+        };
+        let mut attributes = serde_json::Map::new();
+        let n = mesh.positions.len();
+        let position = self.accessor(
+            floats(&mut mesh.positions.iter().flat_map(|p| p.to_array())),
+            ARRAY_BUFFER,
+            FLOAT,
+            "VEC3",
+            n,
+        );
+        let (lo, hi) = crate::mesh::bounds_of(&mesh.positions).unwrap_or_default();
+        self.accessors[position]["min"] = json!(lo.to_array());
+        self.accessors[position]["max"] = json!(hi.to_array());
+        attributes.insert("POSITION".into(), json!(position));
+        if let Some(normals) = &properties.normals {
+            let filled;
+            let normals = if normals.contains(&Vec3::ZERO) {
+                filled = fill_zero_normals(mesh, normals);
+                &filled
+            } else {
+                normals
+            };
+            let a = self.accessor(
+                floats(&mut normals.iter().flat_map(|v| v.to_array())),
+                ARRAY_BUFFER,
+                FLOAT,
+                "VEC3",
+                n,
+            );
+            attributes.insert("NORMAL".into(), json!(a));
+        }
+        if let Some(uvs) = &properties.uvs {
+            let a = self.accessor(
+                floats(&mut uvs.iter().flat_map(|t| [t.x, 1.0 - t.y])),
+                ARRAY_BUFFER,
+                FLOAT,
+                "VEC2",
+                n,
+            );
+            attributes.insert("TEXCOORD_0".into(), json!(a));
+        }
+        if let Some(colors) = &properties.colors {
+            let a = self.accessor(
+                floats(&mut colors.iter().flat_map(|c| c.to_array())),
+                ARRAY_BUFFER,
+                FLOAT,
+                "VEC4",
+                n,
+            );
+            attributes.insert("COLOR_0".into(), json!(a));
+        }
+        Ok(json!({ "attributes": attributes, "indices": indices, "mode": TRIANGLES }))
+    }
+
+    /// Puts material 0 into `root`: base-colour texture 0 sampling image 0,
+    /// `texture` (embedded in the buffer, or for a file beside a `.gltf` a
+    /// relative URI; see the module docs).
+    ///
+    /// # Errors
+    /// As [`save_gltf`] for the texture.
+    pub(super) fn material(
+        &mut self,
+        root: &mut Value,
+        texture: &Texture,
+        binary: bool,
+        path: &Path,
+    ) -> Result<()> {
+        let image = self.image(texture, binary, path)?;
         root["images"] = json!([image]);
         root["textures"] = json!([{ "source": 0 }]);
         root["materials"] = json!([{
@@ -151,62 +218,62 @@ pub fn save_gltf(mesh: &Mesh, path: &Path) -> Result<()> {
                 "roughnessFactor": 1.0,
             }
         }]);
-        primitive["material"] = json!(0);
+        Ok(())
     }
-    root["meshes"] = json!([{ "primitives": [primitive] }]);
-    let mut buffer = json!({ "byteLength": out.bin.len() });
-    let bin_path = path.with_extension("bin");
-    if !binary {
-        let name = bin_path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .ok_or_else(|| {
-                Error::InvalidArgument(format!("{}: not a UTF-8 file name", path.display()))
-            })?;
-        buffer["uri"] = json!(encode_uri_segment(name));
-    }
-    root["buffers"] = json!([buffer]);
-    root["bufferViews"] = Value::Array(std::mem::take(&mut out.views));
-    root["accessors"] = Value::Array(std::mem::take(&mut out.accessors));
 
-    if binary {
-        let mut text = serde_json::to_vec(&root).expect("a JSON value serialises");
-        text.resize(text.len().next_multiple_of(4), b' ');
-        let mut bin = out.bin;
-        bin.resize(bin.len().next_multiple_of(4), 0);
-        let total = 12 + 8 + text.len() + 8 + bin.len();
-        let total = u32::try_from(total).map_err(|_| {
-            Error::InvalidArgument(format!(
-                "{}: {total} bytes, more than a .glb holds (4 GiB)",
-                path.display()
-            ))
-        })?;
-        let mut file = Vec::with_capacity(total as usize);
-        file.extend_from_slice(b"glTF");
-        file.extend_from_slice(&2u32.to_le_bytes());
-        file.extend_from_slice(&total.to_le_bytes());
-        for (kind, data) in [(b"JSON", &text), (b"BIN\0", &bin)] {
-            file.extend_from_slice(&(data.len() as u32).to_le_bytes());
-            file.extend_from_slice(kind);
-            file.extend_from_slice(data);
+    /// Completes `root` with the buffer, views and accessors and writes it
+    /// to `path`: one `.glb`, or the `.gltf` and its `<stem>.bin` (each
+    /// whole or not at all, [`crate::output`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for a `.glb` over 4 GiB or a `.gltf`
+    /// whose name is not UTF-8; [`Error::Io`] naming the file that cannot
+    /// be written.
+    pub(super) fn write(self, mut root: Value, binary: bool, path: &Path) -> Result<()> {
+        let mut buffer = json!({ "byteLength": self.bin.len() });
+        let bin_path = path.with_extension("bin");
+        if !binary {
+            let name = bin_path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .ok_or_else(|| {
+                    Error::InvalidArgument(format!("{}: not a UTF-8 file name", path.display()))
+                })?;
+            buffer["uri"] = json!(encode_uri_segment(name));
         }
-        crate::output::write_file(path, &file)
-    } else {
-        let text = serde_json::to_vec_pretty(&root).expect("a JSON value serialises");
-        crate::output::write_file(&bin_path, &out.bin)?;
-        crate::output::write_file(path, &text)
+        root["buffers"] = json!([buffer]);
+        root["bufferViews"] = Value::Array(self.views);
+        root["accessors"] = Value::Array(self.accessors);
+
+        if binary {
+            let mut text = serde_json::to_vec(&root).expect("a JSON value serialises");
+            text.resize(text.len().next_multiple_of(4), b' ');
+            let mut bin = self.bin;
+            bin.resize(bin.len().next_multiple_of(4), 0);
+            let total = 12 + 8 + text.len() + 8 + bin.len();
+            let total = u32::try_from(total).map_err(|_| {
+                Error::InvalidArgument(format!(
+                    "{}: {total} bytes, more than a .glb holds (4 GiB)",
+                    path.display()
+                ))
+            })?;
+            let mut file = Vec::with_capacity(total as usize);
+            file.extend_from_slice(b"glTF");
+            file.extend_from_slice(&2u32.to_le_bytes());
+            file.extend_from_slice(&total.to_le_bytes());
+            for (kind, data) in [(b"JSON", &text), (b"BIN\0", &bin)] {
+                file.extend_from_slice(&(data.len() as u32).to_le_bytes());
+                file.extend_from_slice(kind);
+                file.extend_from_slice(data);
+            }
+            crate::output::write_file(path, &file)
+        } else {
+            let text = serde_json::to_vec_pretty(&root).expect("a JSON value serialises");
+            crate::output::write_file(&bin_path, &self.bin)?;
+            crate::output::write_file(path, &text)
+        }
     }
-}
 
-/// The buffer and the views and accessors into it, as they are built.
-#[derive(Default)]
-struct Document {
-    bin: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
-}
-
-impl Document {
     /// Appends `data` as a 4-byte aligned buffer view; returns its index.
     fn view(&mut self, data: &[u8], target: Option<u32>) -> usize {
         self.bin.resize(self.bin.len().next_multiple_of(4), 0);
@@ -280,6 +347,38 @@ impl Document {
     }
 }
 
+/// `normals` with each zero one replaced by the area-weighted normal of
+/// the triangles around its point (all vertices of a point get the same),
+/// or `+z` where those have no area. O(V + T).
+fn fill_zero_normals(mesh: &Mesh, normals: &[Vec3]) -> Vec<Vec3> {
+    let p = &mesh.properties;
+    let points = (0..mesh.positions.len() as u32)
+        .map(|v| p.position_id(v) as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut sum = vec![Vec3::ZERO; points];
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+        // Twice the area times the unit normal: area weighting for free.
+        let n = (b - a).cross(c - a);
+        for &v in t {
+            sum[p.position_id(v) as usize] += n;
+        }
+    }
+    normals
+        .iter()
+        .enumerate()
+        .map(|(v, &n)| {
+            if n != Vec3::ZERO {
+                return n;
+            }
+            sum[p.position_id(v as u32) as usize]
+                .try_normalize()
+                .unwrap_or(Vec3::Z)
+        })
+        .collect()
+}
+
 /// `image/png` or `image/jpeg` from the image's signature.
 fn sniff_mime(bytes: &[u8]) -> Option<&'static str> {
     if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
@@ -291,47 +390,18 @@ fn sniff_mime(bytes: &[u8]) -> Option<&'static str> {
     }
 }
 
-/// The URI of `file` relative to `folder`, both made absolute against the
-/// working directory (no symbolic link is resolved), each segment
-/// percent-encoded.
+/// The URI of `file` relative to `folder` ([`super::relative_segments`]),
+/// each segment percent-encoded.
 fn relative_uri(file: &Path, folder: &Path) -> Result<String> {
-    let absolute = |p: &Path| {
-        std::path::absolute(if p.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            p
-        })
-        .map_err(|source| Error::Io {
-            file: p.to_owned(),
-            source,
-        })
-    };
-    fn normal(p: &Path) -> Vec<Component<'_>> {
-        p.components()
-            .filter(|c| !matches!(c, Component::CurDir))
-            .collect()
-    }
-    let (file_abs, folder_abs) = (absolute(file)?, absolute(folder)?);
-    let (f, d) = (normal(&file_abs), normal(&folder_abs));
-    let common = f.iter().zip(&d).take_while(|(a, b)| a == b).count();
-    if common == 0 {
+    let Some(segments) = super::relative_segments(file, folder)? else {
         return Err(Error::InvalidArgument(format!(
             "texture {} has no relative path from {}",
             file.display(),
             folder.display()
         )));
-    }
-    let mut segments: Vec<String> = vec!["..".into(); d.len() - common];
-    for c in &f[common..] {
-        let Some(s) = c.as_os_str().to_str() else {
-            return Err(Error::InvalidArgument(format!(
-                "texture {}: not a UTF-8 path",
-                file.display()
-            )));
-        };
-        segments.push(encode_uri_segment(s));
-    }
-    Ok(segments.join("/"))
+    };
+    let encoded: Vec<String> = segments.iter().map(|s| encode_uri_segment(s)).collect();
+    Ok(encoded.join("/"))
 }
 
 /// Percent-encodes everything but RFC 3986's unreserved characters.

@@ -5,25 +5,34 @@
 //! indices are in range, or an error naming the file and the place; [`load`]
 //! then cleans it (see [`crate::mesh::clean`]).
 //!
-//! Writing: [`save_obj`], and [`save_ply`] (binary, with the mesh's normals,
-//! texture coordinates, colours and texture file name).
+//! Writing: [`save_mesh`] by extension ([`save_obj`] with a `.mtl` for
+//! the texture, [`save_ply`] binary, `save_gltf` with the feature), every
+//! property the format can hold ([`dropped_by`] names the rest); a chain
+//! of levels in one glTF file for engines (`save_lod_chain`: MSFT_lod,
+//! levels of [`ChainLevel`] in vertex-cache order).
 
 #[cfg(feature = "gltf")]
 mod gltf;
 #[cfg(feature = "gltf")]
 mod gltf_write;
+mod lod_chain;
 mod obj;
 mod ply;
 
 #[cfg(feature = "gltf")]
-pub use gltf::{parse_gltf, parse_gltf_with};
+pub use gltf::{gltf_part_count, parse_gltf, parse_gltf_parts, parse_gltf_with, GltfPart};
 #[cfg(feature = "gltf")]
 pub use gltf_write::save_gltf;
-pub use obj::{parse_obj, parse_obj_with};
+#[cfg(feature = "gltf")]
+pub use lod_chain::save_lod_chain;
+pub use lod_chain::{
+    chain_from_collapses, order_for_cache, screen_coverages, ChainLevel, Coverage,
+};
+pub use obj::{parse_obj, parse_obj_with, save_obj};
 pub use ply::parse_ply;
 pub use ply::save_ply;
 
-use super::{clean, CleanOptions, CleanReport, Mesh, RawMesh};
+use super::{clean, CleanOptions, CleanReport, Mesh, RawMesh, Texture};
 use crate::error::{Error, Result};
 use std::path::Path;
 
@@ -282,107 +291,208 @@ pub fn load_bytes(bytes: &[u8], path: &Path, options: LoadOptions) -> Result<(Me
 }
 
 /// Writes `mesh` in the format its extension names: `.obj`
-/// ([`save_obj`]), `.ply` ([`save_ply`]), and with the `gltf` feature `.glb` and `.gltf`
-/// (`save_gltf`).
+/// ([`save_obj`]), `.ply` ([`save_ply`]), and with the `gltf` feature `.glb`
+/// and `.gltf` (`save_gltf`). Each writes every vertex of `mesh` in its
+/// order, with every property the format holds; [`dropped_by`] names what
+/// it cannot hold. A level of a model is made compact first with
+/// [`Mesh::level`] (only the vertices its triangles use).
 ///
 /// # Errors
 /// [`Error::Io`] naming the file; [`Error::UnknownFormat`] for another
-/// extension.
+/// extension; as the format's writer.
 pub fn save_mesh(mesh: &Mesh, path: &Path) -> Result<()> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
+    match extension(path).as_deref() {
         Some("obj") => save_obj(mesh, path),
         Some("ply") => save_ply(mesh, path),
         #[cfg(feature = "gltf")]
         Some("glb" | "gltf") => save_gltf(mesh, path),
         _ => Err(Error::UnknownFormat {
             file: path.to_owned(),
-            message: "writes .obj, .ply, .glb and .gltf (by extension)".into(),
+            message: if cfg!(feature = "gltf") {
+                "writes .obj, .ply, .glb and .gltf (by extension)"
+            } else {
+                "writes .obj and .ply (by extension; .glb and .gltf with the feature `gltf`)"
+            }
+            .into(),
         }),
     }
 }
 
-/// Writes `mesh` as OBJ text to `path`: one `v` line per point (vertices
-/// split at a seam share it, so the seam reads back as one), `vt` and `vn`
-/// lines when the mesh has texture coordinates or normals (one per
-/// vertex), and `f` lines with 1-based indices; floats in the shortest
-/// form that reads back to the same bits. Colours are written as
-/// `v x y z r g b`, per point (OBJ has no alpha and no colour seam: the
-/// first vertex of a point gives it). A texture is referenced through a `.mtl` file written beside the
-/// OBJ (`map_Kd`): a file texture by its path, an embedded one written as
-/// an image file beside the OBJ.
+/// What of `mesh` the format [`save_mesh`] picks for `path` cannot hold,
+/// as names for one warning ("colour alpha", "colour seams"), in that
+/// order; empty when everything is written, and for an extension
+/// [`save_mesh`] refuses.
+///
+/// - OBJ holds normals, texture coordinates and the texture (a `.mtl`
+///   beside it) but colours only as `v x y z r g b`, one per point: an
+///   alpha other than 1 is "colour alpha", vertices of one point with
+///   different colours are "colour seams" (the first vertex's is kept).
+/// - PLY and glTF hold every property ([`save_ply`] quantises colours to
+///   8 bits a channel, which is not counted as a loss).
+///
+/// Position ids (which split vertices are one point) are not listed: PLY
+/// and glTF have no place for them, and loading welds bit-identical
+/// positions back into one point.
+///
+/// Cost: O(vertices) for an OBJ with colours, O(1) otherwise.
+#[must_use]
+pub fn dropped_by(mesh: &Mesh, path: &Path) -> Vec<&'static str> {
+    let mut dropped = Vec::new();
+    if extension(path).as_deref() != Some("obj") {
+        return dropped;
+    }
+    let Some(colors) = &mesh.properties.colors else {
+        return dropped;
+    };
+    if colors.iter().any(|c| c.w != 1.0) {
+        dropped.push("colour alpha");
+    }
+    let mut first: Vec<Option<[u32; 3]>> = Vec::new();
+    let seams = colors.iter().enumerate().any(|(v, c)| {
+        let id = mesh.properties.position_id(v as u32) as usize;
+        if first.len() <= id {
+            first.resize(id + 1, None);
+        }
+        let rgb = c.truncate().to_array().map(f32::to_bits);
+        *first[id].get_or_insert(rgb) != rgb
+    });
+    if seams {
+        dropped.push("colour seams");
+    }
+    dropped
+}
+
+/// The extension of `path`, lower case.
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+}
+
+/// How a mesh file at `path` (OBJ's `.mtl`, PLY's `TextureFile`) names
+/// `texture`, relative to `path`'s folder: a file in that folder or below
+/// by its relative path (`/` between segments), when `fits` accepts it; any
+/// other file, and embedded bytes, copied beside `path` as `<stem>.<ext>`
+/// (white space in the stem made `_`; the file's own extension, else
+/// `png` or `jpg` by MIME type or signature) and named so. The output's
+/// folder then holds everything it refers to: it can be moved whole, and
+/// readers that refuse paths climbing out of it (trimesh) find the image.
+/// A file that cannot be read (loading already warns about missing
+/// textures and drops them) is named where it is, relative (`..`) or
+/// absolute, when `fits` accepts that. Written whole or not at all
+/// ([`crate::output`]).
 ///
 /// # Errors
-/// [`Error::Io`] naming the file.
-pub fn save_obj(mesh: &Mesh, path: &Path) -> Result<()> {
-    use std::fmt::Write as _;
-    use std::io::Write;
-    let props = &mesh.properties;
-    let mut head = String::new();
-    if let Some(texture) = &props.texture {
-        let stem = path
-            .file_stem()
-            .map_or("mesh".into(), |s| s.to_string_lossy());
-        let folder = path.parent().unwrap_or(Path::new(""));
-        let image = match texture {
-            crate::mesh::Texture::File(file) => file.display().to_string(),
-            crate::mesh::Texture::Embedded { mime, bytes } => {
-                let ext = if mime.contains("jpeg") { "jpg" } else { "png" };
-                let name = format!("{stem}.{ext}");
-                crate::output::write_file(&folder.join(&name), bytes)?;
-                name
+/// [`Error::Io`] naming the texture file that cannot be read (and cannot
+/// be named) or the copy that cannot be written;
+/// [`Error::InvalidArgument`] for a texture path that is not UTF-8.
+pub(crate) fn texture_beside(
+    texture: &Texture,
+    path: &Path,
+    fits: impl Fn(&str) -> bool,
+) -> Result<String> {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let (ext, bytes) = match texture {
+        Texture::File(file) => {
+            let relative = relative_segments(file, folder)?;
+            let inside = relative
+                .as_ref()
+                .filter(|s| s.first().is_some_and(|first| first != ".."))
+                .map(|s| s.join("/"))
+                .filter(|name| fits(name));
+            if let Some(name) = inside {
+                return Ok(name);
             }
-        };
-        let mtl = format!("{stem}.mtl");
-        crate::output::write_file(
-            &folder.join(&mtl),
-            format!("newmtl textured\nKd 1 1 1\nmap_Kd {image}\n").as_bytes(),
-        )?;
-        let _ = write!(head, "mtllib {mtl}\nusemtl textured\n");
-    }
-    crate::output::write_with(path, |w| {
-        w.write_all(head.as_bytes())?;
-        let mut points_written = 0;
-        for (i, p) in mesh.positions.iter().enumerate() {
-            // Points are numbered in order of first use: a new one is next.
-            if props.position_id(i as u32) != points_written {
-                continue;
-            }
-            points_written += 1;
-            match &props.colors {
-                Some(c) => {
-                    let c = c[i];
-                    writeln!(w, "v {} {} {} {} {} {}", p.x, p.y, p.z, c.x, c.y, c.z)
+            let bytes = match read_file(file) {
+                Ok(bytes) => bytes,
+                Err(e) => {
+                    // Nothing to copy: named where it is, as the input did.
+                    let name = match relative {
+                        Some(s) => s.join("/"),
+                        None => std::path::absolute(file)
+                            .unwrap_or_else(|_| file.to_owned())
+                            .display()
+                            .to_string(),
+                    };
+                    return if fits(&name) { Ok(name) } else { Err(e) };
                 }
-                None => writeln!(w, "v {} {} {}", p.x, p.y, p.z),
-            }?;
+            };
+            let ext = file
+                .extension()
+                .and_then(|e| e.to_str())
+                .filter(|e| !e.is_empty() && !e.contains(char::is_whitespace))
+                .map_or_else(
+                    || image_extension("", &bytes).to_owned(),
+                    str::to_ascii_lowercase,
+                );
+            (ext, std::borrow::Cow::Owned(bytes))
         }
-        for t in props.uvs.iter().flatten() {
-            writeln!(w, "vt {} {}", t.x, t.y)?;
-        }
-        for n in props.normals.iter().flatten() {
-            writeln!(w, "vn {} {} {}", n.x, n.y, n.z)?;
-        }
-        let corner = |v: u32| {
-            let p = props.position_id(v) + 1;
-            let v = v + 1;
-            match (props.uvs.is_some(), props.normals.is_some()) {
-                (false, false) => format!("{p}"),
-                (true, false) => format!("{p}/{v}"),
-                (false, true) => format!("{p}//{v}"),
-                (true, true) => format!("{p}/{v}/{v}"),
-            }
+        Texture::Embedded { mime, bytes } => (
+            image_extension(mime, bytes).to_owned(),
+            std::borrow::Cow::Borrowed(bytes.as_slice()),
+        ),
+    };
+    let stem: String = path
+        .file_stem()
+        .map_or("mesh".into(), |s| s.to_string_lossy())
+        .chars()
+        .map(|c| if c.is_whitespace() { '_' } else { c })
+        .collect();
+    let name = format!("{stem}.{ext}");
+    crate::output::write_file(&folder.join(&name), &bytes)?;
+    Ok(name)
+}
+
+/// `jpg` for a JPEG (by MIME type, else by signature), else `png`.
+fn image_extension(mime: &str, bytes: &[u8]) -> &'static str {
+    let jpeg = mime.contains("jpeg") || (mime.is_empty() && bytes.starts_with(&[0xff, 0xd8, 0xff]));
+    if jpeg {
+        "jpg"
+    } else {
+        "png"
+    }
+}
+
+/// The path of `file` relative to `folder` as segments (`..` to climb),
+/// both made absolute against the working directory (no symbolic link is
+/// resolved); `None` when they share no root (another drive).
+///
+/// # Errors
+/// [`Error::Io`] when the working directory cannot be read,
+/// [`Error::InvalidArgument`] when a segment is not UTF-8.
+pub(crate) fn relative_segments(file: &Path, folder: &Path) -> Result<Option<Vec<String>>> {
+    use std::path::Component;
+    let absolute = |p: &Path| {
+        std::path::absolute(if p.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            p
+        })
+        .map_err(|source| Error::Io {
+            file: p.to_owned(),
+            source,
+        })
+    };
+    fn normal(p: &Path) -> Vec<Component<'_>> {
+        p.components()
+            .filter(|c| !matches!(c, Component::CurDir))
+            .collect()
+    }
+    let (file_abs, folder_abs) = (absolute(file)?, absolute(folder)?);
+    let (f, d) = (normal(&file_abs), normal(&folder_abs));
+    let common = f.iter().zip(&d).take_while(|(a, b)| a == b).count();
+    if common == 0 {
+        return Ok(None);
+    }
+    let mut segments: Vec<String> = vec!["..".into(); d.len() - common];
+    for c in &f[common..] {
+        let Some(s) = c.as_os_str().to_str() else {
+            return Err(Error::InvalidArgument(format!(
+                "texture {}: not a UTF-8 path",
+                file.display()
+            )));
         };
-        for t in &mesh.triangles {
-            if props.is_empty() {
-                writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)
-            } else {
-                writeln!(w, "f {} {} {}", corner(t[0]), corner(t[1]), corner(t[2]))
-            }?;
-        }
-        Ok(())
-    })
+        segments.push(s.to_owned());
+    }
+    Ok(Some(segments))
 }

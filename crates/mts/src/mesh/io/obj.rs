@@ -1,5 +1,6 @@
-//! Wavefront OBJ reader: `v`, `f`, and with properties `vt`, `vn` and the
-//! material's `map_Kd`; polygons triangulated by
+//! Wavefront OBJ reader and writer ([`save_obj`]). The reader: `v`, `f`,
+//! and with properties `vt`, `vn` and the material's `map_Kd`; polygons
+//! triangulated by
 //! [`super::triangulate_polygon`] (quads as the fan `tobj` made), all
 //! objects and groups merged, lines (`l`), points (`p`) and everything else
 //! ignored.
@@ -31,7 +32,7 @@
 //! [`RawMesh::degenerate_in_source`] instead of vanishing.
 
 use crate::error::{Error, Place, Result};
-use crate::mesh::{RawMesh, Texture};
+use crate::mesh::{Mesh, RawMesh, Texture};
 use glam::{Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
@@ -737,6 +738,100 @@ fn numbers<'a>(
         n += 1;
     }
     Ok((n, values))
+}
+
+/// Writes `mesh` as OBJ text to `path`: one `v` line per point (vertices
+/// split at a seam share it, so the seam reads back as one), `vt` and `vn`
+/// lines when the mesh has texture coordinates or normals (one per
+/// vertex), and `f` lines with 1-based indices (`f p/t/n`); floats in the
+/// shortest form that reads back to the same bits. A mesh without
+/// properties is `v` and `f` lines only, byte for byte what this writer
+/// always wrote. Colours are written as `v x y z r g b`, per point: OBJ
+/// has no alpha and no colour seam, the first vertex of a point gives it
+/// ([`super::dropped_by`] names what is lost).
+///
+/// A texture is named by a `.mtl` written beside the OBJ as `<stem>.mtl`
+/// (`mtllib`, `usemtl textured`, `map_Kd`): a [`Texture::File`] in the
+/// OBJ's folder or below by its relative path (not copied), unless that
+/// path holds white space (which `map_Kd` readers cut at); any other file,
+/// and an embedded image, is copied beside the OBJ as `<stem>.png` (or its
+/// own extension) and named so, so that the output folder holds everything
+/// it refers to (a file that cannot be read is named where it is:
+/// [`super::texture_beside`]). Every file is written whole or not at all
+/// ([`crate::output`]), the image and `.mtl` before the OBJ.
+///
+/// # Errors
+/// [`Error::Io`] naming the file that cannot be written (or the texture
+/// file that cannot be read for a copy); [`Error::InvalidArgument`] for a
+/// texture path that is not UTF-8.
+///
+/// Cost: O(V + T), one buffered write.
+pub fn save_obj(mesh: &Mesh, path: &Path) -> Result<()> {
+    use std::io::Write;
+    let props = &mesh.properties;
+    let head = match &props.texture {
+        Some(texture) => write_material(texture, path)?,
+        None => String::new(),
+    };
+    crate::output::write_with(path, |w| {
+        w.write_all(head.as_bytes())?;
+        let mut points_written = 0;
+        for (i, p) in mesh.positions.iter().enumerate() {
+            // Points are numbered in order of first use: a new one is next.
+            if props.position_id(i as u32) != points_written {
+                continue;
+            }
+            points_written += 1;
+            match &props.colors {
+                Some(c) => {
+                    let c = c[i];
+                    writeln!(w, "v {} {} {} {} {} {}", p.x, p.y, p.z, c.x, c.y, c.z)
+                }
+                None => writeln!(w, "v {} {} {}", p.x, p.y, p.z),
+            }?;
+        }
+        for t in props.uvs.iter().flatten() {
+            writeln!(w, "vt {} {}", t.x, t.y)?;
+        }
+        for n in props.normals.iter().flatten() {
+            writeln!(w, "vn {} {} {}", n.x, n.y, n.z)?;
+        }
+        let corner = |v: u32| {
+            let p = props.position_id(v) + 1;
+            let v = v + 1;
+            match (props.uvs.is_some(), props.normals.is_some()) {
+                (false, false) => format!("{p}"),
+                (true, false) => format!("{p}/{v}"),
+                (false, true) => format!("{p}//{v}"),
+                (true, true) => format!("{p}/{v}/{v}"),
+            }
+        };
+        for t in &mesh.triangles {
+            if props.is_empty() {
+                writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)
+            } else {
+                writeln!(w, "f {} {} {}", corner(t[0]), corner(t[1]), corner(t[2]))
+            }?;
+        }
+        Ok(())
+    })
+}
+
+/// Writes `<stem>.mtl` (and, where [`save_obj`] says, the image) beside the
+/// OBJ at `path`; returns the OBJ's `mtllib`/`usemtl` lines.
+fn write_material(texture: &Texture, path: &Path) -> Result<String> {
+    // `map_Kd` readers, this crate's included, take the last word.
+    let image = super::texture_beside(texture, path, |name| !name.contains(char::is_whitespace))?;
+    let stem = path
+        .file_stem()
+        .map_or("mesh".into(), |s| s.to_string_lossy());
+    let mtl = format!("{stem}.mtl");
+    let folder = path.parent().unwrap_or(Path::new(""));
+    crate::output::write_file(
+        &folder.join(&mtl),
+        format!("newmtl textured\nKd 1 1 1\nmap_Kd {image}\n").as_bytes(),
+    )?;
+    Ok(format!("mtllib {mtl}\nusemtl textured\n"))
 }
 
 #[cfg(test)]

@@ -972,17 +972,20 @@ fn push_strip(list: &[i64], run: &mut Vec<u32>, raw: &mut RawMesh) {
 /// streams the mesh has, `nx ny nz` and `texture_u texture_v` (the names
 /// MeshLab writes and trimesh tries first) as `float`, `red green blue
 /// alpha` as `uchar` (each channel times 255, rounded); faces as `property
-/// list uchar uint vertex_indices`. A [`Texture::File`] is named by a
-/// `comment TextureFile` line, relative to `path`'s folder when inside it,
-/// else absolute. PLY has no place for an embedded texture or for
-/// position ids, so neither is written: [`parse_ply`] reads the file back
-/// to the same mesh with colours within 1/510, and split vertices come
-/// back as one point when the reader welds ([`crate::mesh::CleanOptions`]).
+/// list uchar uint vertex_indices`. The texture is named by a `comment
+/// TextureFile` line (MeshLab's): a file in `path`'s folder or below by its
+/// relative path; any other file, and an embedded image, copied beside the
+/// PLY as `<stem>.png` (or the file's own extension) and named so (one
+/// that cannot be read is named where it is). PLY has no place
+/// for position ids: [`parse_ply`] reads the file back to the same mesh
+/// with colours within 1/510, and split vertices come back as one point
+/// when the reader welds ([`crate::mesh::CleanOptions`]).
 ///
 /// # Errors
 /// [`Error::Invalid`] when `mesh` breaks an invariant ([`Mesh::validate`]),
 /// [`Error::InvalidArgument`] for a texture path that is not UTF-8 or
-/// holds a line break, [`Error::Io`] naming the file.
+/// holds a line break, [`Error::Io`] naming the file (or the texture file
+/// that cannot be read for its copy, or the copy).
 ///
 /// Cost: O(V + T), one buffered write.
 pub fn save_ply(mesh: &Mesh, path: &Path) -> Result<()> {
@@ -996,8 +999,12 @@ pub fn save_ply(mesh: &Mesh, path: &Path) -> Result<()> {
     mesh.validate()?;
     let streams = &mesh.properties;
     let mut header = String::from("ply\nformat binary_little_endian 1.0\ncomment written by mts\n");
-    if let Some(Texture::File(file)) = &streams.texture {
-        let _ = writeln!(header, "comment TextureFile {}", texture_name(file, path)?);
+    if let Some(texture) = &streams.texture {
+        let _ = writeln!(
+            header,
+            "comment TextureFile {}",
+            texture_name(texture, path)?
+        );
     }
     let _ = write!(
         header,
@@ -1050,21 +1057,27 @@ pub fn save_ply(mesh: &Mesh, path: &Path) -> Result<()> {
     })
 }
 
-/// How a `comment TextureFile` line names `texture` for a PLY at `ply`.
-fn texture_name(texture: &Path, ply: &Path) -> Result<String> {
-    let folder = ply.parent().unwrap_or(Path::new(""));
-    let name = match texture.strip_prefix(folder) {
-        Ok(inside) => inside.to_owned(),
-        Err(_) => std::path::absolute(texture).map_err(|e| {
-            Error::InvalidArgument(format!("texture path {}: {e}", texture.display()))
-        })?,
-    };
-    match name.to_str() {
-        Some(s) if !s.contains(['\n', '\r']) && !s.trim().is_empty() => Ok(s.to_owned()),
-        _ => Err(Error::InvalidArgument(format!(
-            "texture path {} cannot be written on a PLY header line (not UTF-8, empty, or a line break)",
-            texture.display()
-        ))),
+/// How a `comment TextureFile` line names `texture` for a PLY at `ply`
+/// ([`super::texture_beside`]: a file in its folder or below by its
+/// relative path, any other texture copied beside it).
+fn texture_name(texture: &Texture, ply: &Path) -> Result<String> {
+    let one_line = |s: &str| !s.contains(['\n', '\r']) && !s.trim().is_empty();
+    if let Texture::File(file) = texture {
+        // Refused before anything is copied.
+        if file.to_str().is_none_or(|s| s.contains(['\n', '\r'])) {
+            return Err(Error::InvalidArgument(format!(
+                "texture path {} cannot be written on a PLY header line (not UTF-8, or a line break)",
+                file.display()
+            )));
+        }
+    }
+    let name = super::texture_beside(texture, ply, one_line)?;
+    if one_line(&name) {
+        Ok(name)
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "texture name {name:?} cannot be written on a PLY header line"
+        )))
     }
 }
 

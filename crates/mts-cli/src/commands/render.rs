@@ -1,10 +1,14 @@
 //! `mts render`: one LoD of a model drawn headless into a PNG, by the MTS
-//! strips or by the oracle triangle list, through `mts_render`.
+//! strips or by the oracle triangle list, through `mts_render`; a glTF file
+//! of several parts drawn as a scene of them ([`GltfScene`]).
 
-use super::{LevelArgs, MeshSource};
+use crate::args::{LevelArgs, MeshSource};
+use crate::gltf_scene::GltfScene;
 use crate::stdout::{outln, warnln};
-use anyhow::Result;
+use anyhow::{bail, Result};
+use clap::builder::TypedValueParser;
 use clap::{Args, ValueEnum};
+use mts::methods::Method;
 use mts::{Extractor, MtsModel};
 use mts_render::headless::HeadlessTarget;
 use mts_render::{Camera, Gpu, RendererConfig, StripMode, StripRenderer};
@@ -12,35 +16,46 @@ use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// What draws the LoD.
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// The MTS strips the extractor emits at that LoD.
-    Mts,
+/// What draws the LoD: the MTS strips, the oracle list, or a baseline's
+/// index buffer (`--method mts|list|pm|multilevel|cluster|discrete`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Draw {
+    /// One of the LoD methods ([`Method::Mts`]: the strips the extractor
+    /// emits at that LoD; a baseline: its finest LoD within the MTS LoD's
+    /// triangles, numbered its own way).
+    Method(Method),
     /// The oracle triangle list (the contraction sequence replayed).
     List,
-    /// The progressive-mesh baseline.
-    Pm,
-    /// The progressive multilevel mesh baseline.
-    Multilevel,
-    /// The cluster-tree baseline (its own LoDs: asked for the triangles of
-    /// the MTS LoD).
-    Cluster,
-    /// meshoptimizer simplify at fixed ratios.
-    Discrete,
 }
 
-impl Method {
-    /// The baseline behind this choice, if it is one.
-    fn baseline(self) -> Option<super::Method> {
+impl Draw {
+    /// The name the command line spells it with.
+    fn name(self) -> &'static str {
         match self {
-            Method::Mts | Method::List => None,
-            Method::Pm => Some(super::Method::Pm),
-            Method::Multilevel => Some(super::Method::Multilevel),
-            Method::Cluster => Some(super::Method::Cluster),
-            Method::Discrete => Some(super::Method::Discrete),
+            Draw::Method(m) => m.name(),
+            Draw::List => "list",
         }
     }
+
+    /// The baseline behind this choice, if it is one.
+    fn baseline(self) -> Option<Method> {
+        match self {
+            Draw::Method(Method::Mts) | Draw::List => None,
+            Draw::Method(m) => Some(m),
+        }
+    }
+}
+
+/// `--method`: `list` or a method's name.
+fn draw_parser() -> impl clap::builder::TypedValueParser<Value = Draw> {
+    let mut names: Vec<&'static str> = Method::ALL.iter().map(|m| m.name()).collect();
+    names.insert(1, "list");
+    clap::builder::PossibleValuesParser::new(names).map(|name| {
+        Method::ALL
+            .iter()
+            .find(|m| m.name() == name)
+            .map_or(Draw::List, |&m| Draw::Method(m))
+    })
 }
 
 /// How strips reach the GPU.
@@ -75,7 +90,10 @@ impl std::str::FromStr for Size {
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// An .mts model, or an OBJ/PLY mesh (the model is built on the fly).
+    /// An .mts model, or an OBJ/PLY/glTF mesh (the model is built on the
+    /// fly). A glTF file of several parts (mesh primitives) is drawn as a
+    /// scene: each part with its own texture or material colour, once per
+    /// node that holds it, each at the coarsest LoD within --pixel-error.
     #[command(flatten)]
     source: MeshSource,
     /// The LoD to draw (the full mesh when none is given).
@@ -87,9 +105,10 @@ pub struct RenderArgs {
     /// Image size in pixels.
     #[arg(long, default_value = "1024x768")]
     size: Size,
-    /// MTS strips or the oracle triangle list.
-    #[arg(long, value_enum, default_value_t = Method::Mts)]
-    method: Method,
+    /// MTS strips, the oracle triangle list, or a baseline (its finest LoD
+    /// within the MTS LoD's triangles).
+    #[arg(long, value_parser = draw_parser(), default_value = "mts")]
+    method: Draw,
     /// How strips are sent to the GPU.
     #[arg(long, value_enum, default_value_t = StripModeArg::Auto)]
     strip_mode: StripModeArg,
@@ -106,25 +125,44 @@ pub struct RenderArgs {
     /// by LoD bucket; 1000 when N is left out).
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
           conflicts_with_all = ["lod", "triangles", "ratio", "method"],
-          allow_negative_numbers = true, value_parser = crate::count_in::<1, { MAX_SCENE }>)]
+          allow_negative_numbers = true, value_parser = crate::args::count_in::<1, { MAX_SCENE }>)]
     scene: Option<usize>,
     /// With --scene: more models (OBJ/PLY meshes), their instances taken
     /// in turn with the command's model.
     #[arg(long, value_name = "MESH", num_args = 1.., requires = "scene")]
     scene_with: Vec<PathBuf>,
-    /// With --scene: the screen-space error allowed, in pixels (0 draws
-    /// every instance at full detail).
-    #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR, requires = "scene",
-          allow_hyphen_values = true, value_parser = crate::pixel_error)]
-    pixel_error: f32,
+    /// In a scene (--scene, or a glTF file of several parts): the
+    /// screen-space error allowed, in pixels (0 draws every instance at
+    /// full detail) [default: 1].
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::args::pixel_error)]
+    pixel_error: Option<f32>,
 }
 
-pub fn render(args: &RenderArgs) -> Result<()> {
+impl RenderArgs {
+    /// The pixel threshold of a scene's LoD choice.
+    fn pixel_threshold(&self) -> f32 {
+        self.pixel_error
+            .unwrap_or(mts_render::scene::DEFAULT_PIXEL_ERROR)
+    }
+}
+
+pub fn run(args: &RenderArgs) -> Result<()> {
     let mut inputs: Vec<&Path> = args.scene_with.iter().map(PathBuf::as_path).collect();
     inputs.extend(args.source.mesh.as_deref());
-    crate::check_output(&args.output, &inputs)?;
+    crate::args::check_output(&args.output, &inputs)?;
     let Size(width, height) = args.size;
     let t0 = Instant::now();
+    if let (None, Some(path)) = (args.scene, &args.source.mesh) {
+        if let Some(scene) = GltfScene::load_if_several(path, args.source.load_options())? {
+            return render_gltf(args, &scene);
+        }
+    }
+    if args.scene.is_none() && args.pixel_error.is_some() {
+        bail!(
+            "--pixel-error chooses the LoDs of a scene (--scene, or a glTF file of several \
+             parts); one model is drawn at --lod, --triangles or --ratio"
+        );
+    }
     let (name, model) = args.source.model()?;
     let ms_model = t0.elapsed().as_secs_f64() * 1e3;
     if let Some(count) = args.scene {
@@ -146,7 +184,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         // A baseline numbers its vertices its own way: a renderer over them,
         // and its finest LoD within the MTS LoD's triangles.
         Some(b) => {
-            let mut source = super::make_source(b, &model, &model.mesh())?;
+            let mut source = b.source(&model, &model.mesh())?;
             let mut r = StripRenderer::for_source(device, queue, &config, source.as_mut())?;
             let own = mts::lod::lod_for_triangles(&*source, model.triangle_count(lod));
             source.set_lod(own);
@@ -161,7 +199,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             for w in r.warnings() {
                 warnln!("{w}");
             }
-            if args.method == Method::Mts {
+            if args.method == Draw::Method(Method::Mts) {
                 let mut ex = Extractor::new(&model);
                 ex.set_lod(lod);
                 let upload = r.upload_strips(device, queue, &ex)?;
@@ -184,10 +222,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     image.save_png(&args.output)?;
     let triangles = model.triangle_count(lod);
     // The name the command line spells it with.
-    let method = args
-        .method
-        .to_possible_value()
-        .map_or_else(String::new, |v| v.get_name().to_string());
+    let method = args.method.name();
     if args.json {
         outln!(
             "{}",
@@ -256,7 +291,7 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     models.extend(others.iter().map(|(_, m)| m));
     let mut scene = DemoScene::new(device, queue, &config, &models, count, &appearance)?;
     let camera = scene.overview_camera(target.aspect());
-    let pixel_error = args.pixel_error;
+    let pixel_error = args.pixel_threshold();
     let t = Instant::now();
     let first = scene.update(device, queue, &camera, height as f32, pixel_error)?;
     let ms_first_update = t.elapsed().as_secs_f64() * 1e3;
@@ -333,63 +368,157 @@ fn render_scene(args: &RenderArgs, name: &str, model: &MtsModel, count: usize) -
     Ok(())
 }
 
+/// Part lines the text report prints before it says how many more there
+/// are (the JSON lists every part).
+const PART_LINES: usize = 20;
+
+/// `mts render` of a glTF file of several parts: every part a model of the
+/// instanced scene, one instance per node, LoDs by `--pixel-error`, the
+/// camera framing every instance.
+fn render_gltf(args: &RenderArgs, scene: &GltfScene) -> Result<()> {
+    if args.level.lod.is_some() || args.level.triangles.is_some() || args.level.ratio.is_some() {
+        bail!(
+            "{}: a scene of {} parts draws each instance at the coarsest LoD within \
+             --pixel-error; --lod, --triangles and --ratio choose one model's (`mts build` \
+             merges the parts into one)",
+            scene.name,
+            scene.part_count
+        );
+    }
+    if args.method != Draw::Method(Method::Mts) {
+        bail!(
+            "{}: a scene of {} parts is drawn by the MTS strips only; --method chooses how one \
+             model is drawn (`mts build` merges the parts into one)",
+            scene.name,
+            scene.part_count
+        );
+    }
+    let Size(width, height) = args.size;
+    let gpu = Gpu::new_headless()?;
+    let mut report = gpu.report();
+    report.strip_mode = match args.strip_mode {
+        StripModeArg::Auto => report.strip_mode,
+        StripModeArg::Restart => StripMode::Restart,
+        StripModeArg::Stitched => StripMode::Stitched,
+    };
+    let config = RendererConfig::headless(report.strip_mode);
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let target = HeadlessTarget::new(device, width, height)?;
+    let appearance = mts_render::Appearance {
+        checker: args.checker,
+    };
+    let (mut instanced, instances) = scene.scene(device, queue, &config, &appearance)?;
+    let camera = scene.camera(target.aspect());
+    let pixel_error = args.pixel_threshold();
+    let t = Instant::now();
+    let stats = instanced.update(device, queue, &camera, height as f32, pixel_error)?;
+    let ms_update = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let image = target.render_image(device, queue, |pass| instanced.draw(pass))?;
+    let ms_render = t.elapsed().as_secs_f64() * 1e3;
+    image.save_png(&args.output)?;
+    let parts: Vec<_> = scene
+        .models
+        .iter()
+        .zip(&instances)
+        .map(|(m, ids)| {
+            let lods: Vec<Option<usize>> = ids.iter().map(|&i| instanced.lod_of(i)).collect();
+            let texture = ids.first().and_then(|i| instanced.texture_size(i.model()));
+            (m, lods, texture)
+        })
+        .collect();
+    let instance_count = scene.instance_count();
+    if args.json {
+        let parts: Vec<_> = parts
+            .iter()
+            .map(|(m, lods, texture)| {
+                json!({
+                    "mesh": m.mesh,
+                    "primitive": m.primitive,
+                    "name": m.name,
+                    "mirrored": m.mirrored,
+                    "triangles": m.model.triangle_count(0),
+                    "max_lod": m.model.max_lod(),
+                    "instances": lods.len(),
+                    "lods": lods,
+                    "texture": texture.map(|(w, h)| [w, h]),
+                })
+            })
+            .collect();
+        outln!(
+            "{}",
+            json!({
+                "input": scene.name,
+                "adapter": report.name,
+                "backend": format!("{:?}", report.backend),
+                "device_type": format!("{:?}", report.device_type),
+                "strip_mode": report.strip_mode.to_string(),
+                "part_count": scene.part_count,
+                "parts": parts,
+                "instances": instance_count,
+                "visible": stats.visible,
+                "triangles": stats.triangles,
+                "triangles_full_detail": stats.triangles_full_detail,
+                "pixel_threshold": pixel_error,
+                "indices_drawn": stats.indices_drawn,
+                "draws": stats.draws,
+                "camera": {
+                    "view_proj": camera.view_proj.to_cols_array(),
+                    "light_dir": camera.light_dir.to_array(),
+                },
+                "foreground_pixels": image.foreground_pixels(),
+                "ms_update": ms_update,
+                "ms_render_readback": ms_render,
+                "output": args.output.display().to_string(),
+            })
+        )?;
+        return Ok(());
+    }
+    print_text(&scene.name, &report, &args.output)?;
+    outln!(
+        "  scene     {} parts, {instance_count} instances ({} visible): {} triangles of {} at full \
+         detail within {pixel_error} px, {} indices drawn in {} instanced draws",
+        scene.part_count,
+        stats.visible,
+        stats.triangles,
+        stats.triangles_full_detail,
+        stats.indices_drawn,
+        stats.draws
+    )?;
+    for (m, lods, texture) in parts.iter().take(PART_LINES) {
+        let mut drawn: Vec<usize> = lods.iter().flatten().copied().collect();
+        drawn.sort_unstable();
+        drawn.dedup();
+        let drawn: Vec<String> = drawn.iter().map(usize::to_string).collect();
+        outln!(
+            "  part      {}: {} triangles, {} instance{} ({} drawn, at LoD {}), {}",
+            m.label(),
+            m.model.triangle_count(0),
+            lods.len(),
+            if lods.len() == 1 { "" } else { "s" },
+            lods.iter().flatten().count(),
+            if drawn.is_empty() {
+                "-".into()
+            } else {
+                drawn.join(", ")
+            },
+            texture.map_or_else(|| "untextured".into(), |(w, h)| format!("textured {w}x{h}"))
+        )?;
+    }
+    if parts.len() > PART_LINES {
+        outln!(
+            "  part      ... {} more (--json lists them all)",
+            parts.len() - PART_LINES
+        )?;
+    }
+    outln!(
+        "  time      update+extract {ms_update:.2} ms, render+readback {ms_render:.1} ms; {} \
+         foreground pixels of {}",
+        image.foreground_pixels(),
+        width as usize * height as usize
+    )
+}
+
 /// Most instances `--scene` lays out (`render`, `view`): about 220 bytes of
 /// CPU and GPU memory each, so at most a few hundred MB.
-const MAX_SCENE: u64 = 1 << 20;
-
-/// Arguments of `mts view`.
-#[derive(Args)]
-pub struct ViewArgs {
-    /// An .mts model, or an OBJ/PLY mesh (the model is built on the fly).
-    #[command(flatten)]
-    source: MeshSource,
-    /// Show N instances on a ground plane instead (1000 when N is left
-    /// out); `F` flies through them.
-    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
-          allow_negative_numbers = true, value_parser = crate::count_in::<1, { MAX_SCENE }>)]
-    scene: Option<usize>,
-    /// With --scene: more models (OBJ/PLY meshes), their instances taken
-    /// in turn with the command's model.
-    #[arg(long, value_name = "MESH", num_args = 1.., requires = "scene")]
-    scene_with: Vec<PathBuf>,
-    /// Quit after this many frames (scripted runs).
-    #[arg(long)]
-    frames: Option<u64>,
-    /// Texture the model with a checker (shows UV distortion) instead of
-    /// its own texture; needs texture coordinates (`--properties`, or a
-    /// model built with them).
-    #[arg(long)]
-    checker: bool,
-}
-
-/// `mts view`: opens the viewer window.
-pub fn view(args: &ViewArgs) -> Result<()> {
-    use crate::viewer::{run, ViewerContent};
-    let (name, model) = args.source.model()?;
-    let content = match args.scene {
-        Some(count) => ViewerContent::Scene {
-            count,
-            checker: args.checker,
-        },
-        None => ViewerContent::Model {
-            checker: args.checker,
-        },
-    };
-    let others = crate::demo_scene::load_models(&args.scene_with)?;
-    let others: Vec<&MtsModel> = others.iter().map(|(_, m)| m).collect();
-    let report = run(
-        &model,
-        &others,
-        content,
-        &format!("mts view: {name}"),
-        args.frames,
-    )?;
-    outln!(
-        "{name}: {} frames in {:.1} s on {}; last: {}",
-        report.frames,
-        report.seconds,
-        report.adapter,
-        report.last_status
-    )?;
-    Ok(())
-}
+pub const MAX_SCENE: u64 = 1 << 20;

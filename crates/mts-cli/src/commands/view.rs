@@ -1,0 +1,88 @@
+//! `mts view`: a window on a model (orbit camera, LoD by wheel or by
+//! screen-space error), on a scene of instances (`--scene`) or on a glTF
+//! file of several parts; the window itself is [`crate::viewer`].
+
+use super::render::MAX_SCENE;
+use crate::args::MeshSource;
+use crate::gltf_scene::GltfScene;
+use crate::stdout::outln;
+use anyhow::Result;
+use clap::Args;
+use mts::MtsModel;
+use std::path::PathBuf;
+
+/// Arguments of `mts view`.
+#[derive(Args)]
+pub struct ViewArgs {
+    /// An .mts model, or an OBJ/PLY/glTF mesh (the model is built on the
+    /// fly). A glTF file of several parts (mesh primitives) is shown as a
+    /// scene: each part with its own texture or material colour, once per
+    /// node that holds it, each at the coarsest LoD within one pixel.
+    #[command(flatten)]
+    source: MeshSource,
+    /// Show N instances on a ground plane instead (1000 when N is left
+    /// out); `F` flies through them.
+    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
+          allow_negative_numbers = true, value_parser = crate::args::count_in::<1, { MAX_SCENE }>)]
+    scene: Option<usize>,
+    /// With --scene: more models (OBJ/PLY meshes), their instances taken
+    /// in turn with the command's model.
+    #[arg(long, value_name = "MESH", num_args = 1.., requires = "scene")]
+    scene_with: Vec<PathBuf>,
+    /// Quit after this many frames (scripted runs).
+    #[arg(long)]
+    frames: Option<u64>,
+    /// Texture the model with a checker (shows UV distortion) instead of
+    /// its own texture; needs texture coordinates (`--properties`, or a
+    /// model built with them).
+    #[arg(long)]
+    checker: bool,
+}
+
+/// `mts view`: opens the viewer window.
+pub fn run(args: &ViewArgs) -> Result<()> {
+    use crate::viewer::{run, run_gltf, ViewerContent};
+    if let (None, Some(path)) = (args.scene, &args.source.mesh) {
+        if let Some(scene) = GltfScene::load_if_several(path, args.source.load_options())? {
+            let title = format!("mts view: {} ({} parts)", scene.name, scene.part_count);
+            let report = run_gltf(&scene, args.checker, &title, args.frames)?;
+            return outln!(
+                "{}: {} parts, {} instances: {} frames in {:.1} s on {}; last: {}",
+                scene.name,
+                scene.part_count,
+                scene.instance_count(),
+                report.frames,
+                report.seconds,
+                report.adapter,
+                report.last_status
+            );
+        }
+    }
+    let (name, model) = args.source.model()?;
+    let content = match args.scene {
+        Some(count) => ViewerContent::Scene {
+            count,
+            checker: args.checker,
+        },
+        None => ViewerContent::Model {
+            checker: args.checker,
+        },
+    };
+    let others = crate::demo_scene::load_models(&args.scene_with)?;
+    let others: Vec<&MtsModel> = others.iter().map(|(_, m)| m).collect();
+    let report = run(
+        &model,
+        &others,
+        content,
+        &format!("mts view: {name}"),
+        args.frames,
+    )?;
+    outln!(
+        "{name}: {} frames in {:.1} s on {}; last: {}",
+        report.frames,
+        report.seconds,
+        report.adapter,
+        report.last_status
+    )?;
+    Ok(())
+}
