@@ -112,7 +112,7 @@ pub fn simplify_to_lod(mesh: &Mesh, collapses: &Collapses, lod: usize) -> (Vec<[
 
 /// The weights ([`AttributeWeights`], one per stream: each float of the
 /// stream gets it) this peer gives meshoptimizer's `simplifyWithAttributes`
-/// by default. Its scale is not [`crate::simplify`]'s:
+/// by default. Its scale is not [`crate::simplify()`]'s:
 ///
 /// meshoptimizer scales positions into the unit cube (by the largest
 /// extent) and adds each triangle's attribute error, weighted by its area,

@@ -757,7 +757,7 @@ fn numbers<'a>(
 /// and an embedded image, is copied beside the OBJ as `<stem>.png` (or its
 /// own extension) and named so, so that the output folder holds everything
 /// it refers to (a file that cannot be read is named where it is:
-/// [`super::texture_beside`]). Every file is written whole or not at all
+/// `texture_beside`). Every file is written whole or not at all
 /// ([`crate::output`]), the image and `.mtl` before the OBJ.
 ///
 /// # Errors
