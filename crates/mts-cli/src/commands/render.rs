@@ -169,16 +169,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         return render_scene(args, &name, &model, count);
     }
     let lod = args.level.resolve_model(&model)?.unwrap_or(0);
-    let gpu = Gpu::new_headless()?;
-    let mut report = gpu.report();
-    report.strip_mode = match args.strip_mode {
-        StripModeArg::Auto => report.strip_mode,
-        StripModeArg::Restart => StripMode::Restart,
-        StripModeArg::Stitched => StripMode::Stitched,
-    };
-    let config = RendererConfig::headless(report.strip_mode);
+    let (gpu, report, config, target) = headless(args, width, height)?;
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let target = HeadlessTarget::new(device, width, height)?;
     let t1 = Instant::now();
     let (renderer, indices_sent, upload) = match args.method.baseline() {
         // A baseline numbers its vertices its own way: a renderer over them,
@@ -394,16 +386,8 @@ fn render_gltf(args: &RenderArgs, scene: &GltfScene) -> Result<()> {
         );
     }
     let Size(width, height) = args.size;
-    let gpu = Gpu::new_headless()?;
-    let mut report = gpu.report();
-    report.strip_mode = match args.strip_mode {
-        StripModeArg::Auto => report.strip_mode,
-        StripModeArg::Restart => StripMode::Restart,
-        StripModeArg::Stitched => StripMode::Stitched,
-    };
-    let config = RendererConfig::headless(report.strip_mode);
+    let (gpu, report, config, target) = headless(args, width, height)?;
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let target = HeadlessTarget::new(device, width, height)?;
     let appearance = mts_render::Appearance {
         checker: args.checker,
     };
@@ -522,3 +506,28 @@ fn render_gltf(args: &RenderArgs, scene: &GltfScene) -> Result<()> {
 /// Most instances `--scene` lays out (`render`, `view`): about 220 bytes of
 /// CPU and GPU memory each, so at most a few hundred MB.
 pub const MAX_SCENE: u64 = 1 << 20;
+
+/// The headless adapter, its report with the strip mode `--strip-mode`
+/// asks for, the renderer configuration of that mode and a `width` ×
+/// `height` target.
+fn headless(
+    args: &RenderArgs,
+    width: u32,
+    height: u32,
+) -> Result<(
+    Gpu,
+    mts_render::AdapterReport,
+    RendererConfig,
+    HeadlessTarget,
+)> {
+    let gpu = Gpu::new_headless()?;
+    let mut report = gpu.report();
+    report.strip_mode = match args.strip_mode {
+        StripModeArg::Auto => report.strip_mode,
+        StripModeArg::Restart => StripMode::Restart,
+        StripModeArg::Stitched => StripMode::Stitched,
+    };
+    let config = RendererConfig::headless(report.strip_mode);
+    let target = HeadlessTarget::new(&gpu.device, width, height)?;
+    Ok((gpu, report, config, target))
+}
