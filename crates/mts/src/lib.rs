@@ -37,6 +37,7 @@ pub mod checksum;
 pub mod distance;
 pub mod encoding;
 pub mod error;
+pub mod hierarchy;
 pub mod lod;
 pub mod mesh;
 pub mod methods;

@@ -7,7 +7,10 @@
 //! quadrics, `pairs.rs` the candidate pairs, and `queue.rs`, `fans.rs`
 //! and `refusals.rs` the loop's flat structures: the priority queue, the
 //! triangles around each vertex (and the neighbours of wide fans) and the
-//! targets a guard refused.
+//! targets a guard refused. [`simplify_locked`] keeps chosen vertices in
+//! place (a part's border, `crate::hierarchy`); the flags are an argument,
+//! not a field of [`SimplifyOptions`], so that the options stay `Copy` and
+//! callers that spell every field out are unchanged.
 
 mod collapses;
 mod contract;
@@ -18,7 +21,7 @@ mod queue;
 mod refusals;
 
 pub use collapses::{Collapse, Collapses};
-pub use contract::simplify;
+pub use contract::{simplify, simplify_locked};
 
 /// Where a contraction puts the surviving vertex.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

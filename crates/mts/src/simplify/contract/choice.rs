@@ -26,6 +26,9 @@ impl<P: Place> Contractor<P> {
         } else {
             self.fans.retain(v, |t| self.tris[t as usize][0] != DEAD);
         }
+        if self.is_locked(v) {
+            return;
+        }
         let new = P::best(self, v).map_or((f32::INFINITY, NONE), |(c, w)| (c as f32, w));
         let old = self.queued[v as usize];
         if new.0 != old.0 || new.1 != old.1 {
@@ -40,6 +43,10 @@ impl<P: Place> Contractor<P> {
     /// Keys are not told apart by target: equal keys pop together and the
     /// first stands for the current choice.
     pub(super) fn queue(&mut self, v: u32, cost: f32, target: u32) {
+        if self.is_locked(v) {
+            // A locked vertex is never removed: it has no entry.
+            return;
+        }
         self.queued[v as usize] = (cost, target);
         let bits = cost_bits(cost);
         if target != NONE && bits < self.floor[v as usize] {

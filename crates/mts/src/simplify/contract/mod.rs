@@ -116,6 +116,34 @@ use glam::{DVec3, Vec3};
 /// the sequence of the true coordinates; ordinary models are not scaled.
 #[must_use]
 pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
+    simplify_locked(mesh, options, &[])
+}
+
+/// [`simplify`] with some vertices locked in place: `locked` is empty (no
+/// lock: the very sequence [`simplify`] makes) or holds one flag per vertex
+/// of `mesh`. A locked vertex is never removed: with endpoint placement a
+/// contraction `u → v` of a locked `u` is never made (`v` may be locked);
+/// with optimal placement a contraction onto a locked vertex puts the
+/// created vertex exactly at its position (and locks it), and one of two
+/// locked vertices is never made. On a mesh with seams a point is locked
+/// when any of its vertices is. Used to simplify a part of a mesh whose
+/// border must still meet its neighbours' (`crate::hierarchy`).
+///
+/// Cost: as [`simplify`], plus O(vertices) for the flags.
+///
+/// # Panics
+/// As [`simplify`], and if `locked` is neither empty nor one flag per
+/// vertex.
+#[must_use]
+pub fn simplify_locked(mesh: &Mesh, options: &SimplifyOptions, locked: &[bool]) -> Simplification {
+    assert!(
+        locked.is_empty() || locked.len() == mesh.vertex_count(),
+        "simplify_locked: {} lock flags for {} vertices",
+        locked.len(),
+        mesh.vertex_count()
+    );
+    // No flag set is no lock: the unlocked loop, bit for bit.
+    let locked = if locked.contains(&true) { locked } else { &[] };
     let scale = crate::mesh::power_of_two_scale(&mesh.positions);
     if scale != 1.0 {
         let scaled = Mesh {
@@ -123,7 +151,7 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
             triangles: mesh.triangles.clone(),
             properties: mesh.properties.clone(),
         };
-        let mut result = simplify(&scaled, options);
+        let mut result = simplify_locked(&scaled, options, locked);
         for p in &mut result.collapses.appended {
             *p = (p.as_dvec3() / scale).as_vec3();
         }
@@ -131,16 +159,18 @@ pub fn simplify(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
     }
     let with_properties = !mesh.properties.is_empty();
     match options.placement {
-        Placement::Endpoint if with_properties => contract_points::<Endpoint>(mesh, options),
-        Placement::Endpoint => contract::<Endpoint>(mesh, options),
-        Placement::Optimal if with_properties => contract_points::<Optimal>(mesh, options),
-        Placement::Optimal => contract::<Optimal>(mesh, options),
+        Placement::Endpoint if with_properties => {
+            contract_points::<Endpoint>(mesh, options, locked)
+        }
+        Placement::Endpoint => contract::<Endpoint>(mesh, options, locked),
+        Placement::Optimal if with_properties => contract_points::<Optimal>(mesh, options, locked),
+        Placement::Optimal => contract::<Optimal>(mesh, options, locked),
     }
 }
 
 /// The whole sequence with placement `P`.
-fn contract<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
-    let mut c = Contractor::<P>::new(mesh, options);
+fn contract<P: Place>(mesh: &Mesh, options: &SimplifyOptions, locked: &[bool]) -> Simplification {
+    let mut c = Contractor::<P>::new_with(mesh, options, |c| c.locked = locked.to_vec());
     c.run(options.stop_at_triangles);
     c.finish()
 }
@@ -150,7 +180,11 @@ fn contract<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplification 
 /// attribute quadrics in the cost (`attributes.rs`). With optimal placement
 /// each step creates one vertex per seam pair, with interpolated
 /// properties (`created.rs`).
-fn contract_points<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplification {
+fn contract_points<P: Place>(
+    mesh: &Mesh,
+    options: &SimplifyOptions,
+    locked: &[bool],
+) -> Simplification {
     let identity: Vec<u32>;
     let ids = if mesh.properties.position_ids.is_empty() {
         identity = (0..mesh.vertex_count() as u32).collect();
@@ -173,6 +207,12 @@ fn contract_points<P: Place>(mesh: &Mesh, options: &SimplifyOptions) -> Simplifi
         properties: Default::default(),
     };
     let mut c = Contractor::<P>::new_with(&point_mesh, options, |c| {
+        if !locked.is_empty() {
+            c.locked = vec![false; points];
+            for (v, &id) in ids.iter().enumerate() {
+                c.locked[id as usize] |= locked[v];
+            }
+        }
         c.corners.clone_from(&mesh.triangles);
         c.output_vertices = mesh.vertex_count();
         if P::MOVES_KEPT {
@@ -342,9 +382,14 @@ struct Contractor<P> {
     /// Triangles on the input's most crowded edge, at least 2: no merge
     /// may make an edge hold more ([`Contractor::merge_keeps_manifold`]).
     crowding: usize,
+    /// Per vertex, whether it is locked ([`simplify_locked`]): it never
+    /// chooses a target, so it is never the removed end of a contraction.
+    /// Empty when nothing is locked.
+    locked: Vec<bool>,
 }
 
 impl<P: Place> Contractor<P> {
+    #[cfg(test)]
     fn new(mesh: &Mesh, options: &SimplifyOptions) -> Contractor<P> {
         Self::new_with(mesh, options, |_| {})
     }
@@ -475,6 +520,7 @@ impl<P: Place> Contractor<P> {
             scratch: Vec::new(),
             checked: Vec::new(),
             crowding,
+            locked: Vec::new(),
         };
         setup(&mut c);
         P::choose_all(&mut c);
@@ -492,6 +538,12 @@ impl<P: Place> Contractor<P> {
         for &t in around {
             prefetch(&self.tris[t as usize]);
         }
+    }
+
+    /// Whether `v` is locked ([`Contractor::locked`]).
+    #[inline]
+    fn is_locked(&self, v: u32) -> bool {
+        self.locked.get(v as usize).copied().unwrap_or(false)
     }
 
     /// Position of vertex `v` in `f64` (input positions widen exactly).
@@ -827,6 +879,9 @@ impl<P: Place> Contractor<P> {
         self.refusals.push_vertex();
         if !self.partners.is_empty() {
             self.partners.push(Vec::new());
+        }
+        if !self.locked.is_empty() {
+            self.locked.push(false);
         }
         c
     }

@@ -202,14 +202,23 @@ impl Place for Optimal {
 
     fn pair_cost(c: &Contractor<Self>, v: u32, w: u32) -> f64 {
         let q = c.quadrics[v as usize] + c.quadrics[w as usize];
-        let (p, cost) = c.optimal_point(&q, v, w);
+        let (p, cost) = if c.is_locked(w) {
+            (c.p(w), q.mean_error(c.p(w)))
+        } else {
+            c.optimal_point(&q, v, w)
+        };
         match &c.attributes {
             Some(a) => cost + a.cost_between(v, w, p, created::along(c.p(v), c.p(w), p)),
             None => cost,
         }
     }
 
+    /// The locked endpoint's position when `b` is locked (`a` never is:
+    /// it has no queue entry).
     fn target(c: &Contractor<Self>, a: u32, b: u32) -> DVec3 {
+        if c.is_locked(b) {
+            return c.p(b);
+        }
         let q = c.quadrics[a as usize] + c.quadrics[b as usize];
         c.optimal_point(&q, a, b).0
     }
@@ -230,9 +239,14 @@ impl Place for Optimal {
         }
     }
 
-    fn merge(c: &mut Contractor<Self>, _: u32, _: u32, target: DVec3) -> u32 {
+    /// A vertex created onto a locked one stands for it: it is locked too.
+    fn merge(c: &mut Contractor<Self>, _: u32, b: u32, target: DVec3) -> u32 {
         c.place.created.push(target);
-        c.push_vertex()
+        let survivor = c.push_vertex();
+        if c.is_locked(b) {
+            c.locked[survivor as usize] = true;
+        }
+        survivor
     }
 
     fn prefetch(&self, _: u32) {}

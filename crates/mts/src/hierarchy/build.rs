@@ -1,0 +1,285 @@
+//! Builds the DAG level by level (after meshoptimizer's `clodBuild`): cut
+//! the level's triangles into clusters, group them, simplify each group
+//! toward half with its outer border locked, record its strips as an
+//! [`MtsModel`], cut its output into the next level's clusters.
+
+use super::grouping::group;
+use super::partition::partition;
+use super::{Cluster, Group, Hierarchy, HierarchyOptions, NO_GROUP, STUCK_RATIO};
+use crate::mesh::{Mesh, Properties};
+use crate::model::MtsModel;
+use crate::simplify::{simplify_locked, Placement};
+use crate::strip::stripify;
+use glam::Vec3;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Builds the hierarchy of `mesh` (see the module documentation of
+/// [`super`]): groups of each level built in parallel on all cores.
+///
+/// Cost: about that of [`crate::model::build_from_mesh`] over twice the
+/// triangles (each level about half the one below), in pieces of about
+/// `group_clusters × cluster_triangles` triangles; memory about twice the
+/// per-object model's.
+///
+/// # Errors
+/// [`crate::Error::InvalidArgument`] for optimal placement: its created
+/// vertices are not input vertices, which the groups' vertex maps and the
+/// locked borders need.
+///
+/// # Panics
+/// If `mesh` breaks the [`Mesh`] invariants.
+pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy> {
+    if options.pipeline.simplify.placement != Placement::Endpoint {
+        return Err(crate::Error::InvalidArgument(
+            "the hierarchy needs endpoint placement: its groups draw input vertices".into(),
+        ));
+    }
+    let point_of = |v: u32| mesh.properties.position_id(v);
+    let points = (0..mesh.vertex_count() as u32)
+        .map(|v| point_of(v) as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut h = Hierarchy {
+        clusters: Vec::new(),
+        cluster_triangles: Vec::new(),
+        groups: Vec::new(),
+        vertex_count: mesh.vertex_count(),
+        triangle_count: mesh.triangle_count(),
+    };
+    let mut current: Vec<u32> = Vec::new();
+    for part in partition(&mesh.positions, &mesh.triangles, options.cluster_triangles) {
+        let tris = part.iter().map(|&t| mesh.triangles[t as usize]);
+        current.push(h.add_cluster(tris, NO_GROUP));
+    }
+    let mut level = 0u32;
+    while !current.is_empty() {
+        let slices: Vec<&[[u32; 3]]> = current
+            .iter()
+            .map(|&c| h.cluster_triangles(c as usize))
+            .collect();
+        let grouped = group(
+            &mesh.positions,
+            point_of,
+            &slices,
+            options.group_clusters.max(1),
+        );
+        // The outer borders: points that triangles of two groups use.
+        let mut owner = vec![NO_GROUP; points];
+        let mut shared = vec![false; points];
+        for (gi, members) in grouped.iter().enumerate() {
+            for &m in members {
+                for t in slices[m as usize] {
+                    for &v in t {
+                        let p = point_of(v) as usize;
+                        if owner[p] == NO_GROUP {
+                            owner[p] = gi as u32;
+                        } else if owner[p] != gi as u32 {
+                            shared[p] = true;
+                        }
+                    }
+                }
+            }
+        }
+        let inputs: Vec<Vec<[u32; 3]>> = grouped
+            .iter()
+            .map(|members| {
+                members
+                    .iter()
+                    .flat_map(|&m| slices[m as usize].iter().copied())
+                    .collect()
+            })
+            .collect();
+        let built = build_groups(mesh, &inputs, &shared, options);
+        let (mut total_in, mut total_out) = (0usize, 0usize);
+        let mut next = Vec::new();
+        for (gi, b) in built.into_iter().enumerate() {
+            let id = h.groups.len() as u32;
+            let group_inputs: Vec<u32> = grouped[gi].iter().map(|&m| current[m as usize]).collect();
+            let mut children: Vec<u32> = Vec::new();
+            for &c in &group_inputs {
+                let cluster = &mut h.clusters[c as usize];
+                cluster.consumer = id;
+                if cluster.producer != NO_GROUP {
+                    children.push(cluster.producer);
+                }
+            }
+            children.sort_unstable();
+            children.dedup();
+            let mut floor = 0f32;
+            let mut radius = b.radius;
+            for &c in &children {
+                let child = &h.groups[c as usize];
+                floor = floor.max(child.output_error());
+                radius = radius.max(child.centre.distance(b.centre) + child.radius);
+            }
+            total_in += inputs[gi].len();
+            total_out += b.output.len();
+            let mut outputs = Vec::new();
+            for part in partition(&mesh.positions, &b.output, options.cluster_triangles) {
+                let tris = part.iter().map(|&t| b.output[t as usize]);
+                outputs.push(h.add_cluster(tris, id));
+            }
+            next.extend_from_slice(&outputs);
+            h.groups.push(Group {
+                level,
+                inputs: group_inputs,
+                outputs,
+                children,
+                vertices: b.vertices,
+                model: b.model,
+                floor,
+                diagonal: b.diagonal,
+                centre: b.centre,
+                radius,
+            });
+        }
+        let stuck = total_out as f64 > STUCK_RATIO * total_in as f64;
+        if grouped.len() <= 1 || stuck {
+            break;
+        }
+        current = next;
+        level += 1;
+    }
+    #[cfg(debug_assertions)]
+    if let Err(e) = h.validate() {
+        panic!("hierarchy::build made an invalid hierarchy: {e}");
+    }
+    Ok(h)
+}
+
+impl Hierarchy {
+    /// Appends a cluster of `triangles` made by `producer` (not yet
+    /// consumed) and returns its index.
+    fn add_cluster(&mut self, triangles: impl Iterator<Item = [u32; 3]>, producer: u32) -> u32 {
+        let start = self.cluster_triangles.len() as u32;
+        self.cluster_triangles.extend(triangles);
+        self.clusters.push(Cluster {
+            triangles: start..self.cluster_triangles.len() as u32,
+            producer,
+            consumer: NO_GROUP,
+        });
+        (self.clusters.len() - 1) as u32
+    }
+}
+
+/// What [`build_group`] makes of one group's input.
+struct Built {
+    vertices: Vec<u32>,
+    model: MtsModel,
+    diagonal: f32,
+    /// Its last LoD's triangles, in input vertex numbers.
+    output: Vec<[u32; 3]>,
+    centre: Vec3,
+    radius: f32,
+}
+
+/// [`build_group`] of every group, on all cores, in group order.
+fn build_groups(
+    mesh: &Mesh,
+    inputs: &[Vec<[u32; 3]>],
+    shared: &[bool],
+    options: &HierarchyOptions,
+) -> Vec<Built> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, std::num::NonZeroUsize::get)
+        .min(inputs.len())
+        .max(1);
+    let next = AtomicUsize::new(0);
+    let mut done: Vec<(usize, Built)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut remap = vec![u32::MAX; mesh.vertex_count()];
+                    let mut out = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        let Some(tris) = inputs.get(i) else { break };
+                        out.push((i, build_group(mesh, tris, shared, options, &mut remap)));
+                    }
+                    out
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    done.sort_unstable_by_key(|(i, _)| *i);
+    done.into_iter().map(|(_, b)| b).collect()
+}
+
+/// One group: its submesh (input vertices and properties, no texture: the
+/// input's serves), simplified to half its triangles with the points in
+/// `shared` locked, and its model. `remap` is all `u32::MAX` on entry and
+/// on return.
+fn build_group(
+    mesh: &Mesh,
+    triangles: &[[u32; 3]],
+    shared: &[bool],
+    options: &HierarchyOptions,
+    remap: &mut [u32],
+) -> Built {
+    let mut vertices = Vec::new();
+    let local: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                let r = &mut remap[v as usize];
+                if *r == u32::MAX {
+                    *r = vertices.len() as u32;
+                    vertices.push(v);
+                }
+                *r
+            })
+        })
+        .collect();
+    for &v in &vertices {
+        remap[v as usize] = u32::MAX;
+    }
+    let properties = if mesh.properties.is_empty() {
+        Properties::default()
+    } else {
+        Properties {
+            texture: None,
+            ..mesh.properties.gather(&vertices)
+        }
+    };
+    let submesh = Mesh {
+        positions: vertices
+            .iter()
+            .map(|&v| mesh.positions[v as usize])
+            .collect(),
+        triangles: local,
+        properties,
+    };
+    let locked: Vec<bool> = vertices
+        .iter()
+        .map(|&v| shared[mesh.properties.position_id(v) as usize])
+        .collect();
+    let mut simplify_options = options.pipeline.simplify;
+    simplify_options.stop_at_triangles = Some(submesh.triangle_count() / 2);
+    let collapses = simplify_locked(&submesh, &simplify_options, &locked).collapses;
+    let strips = stripify(&submesh, &options.pipeline.stripify);
+    let model = crate::model::build(&submesh, &strips, &collapses, &options.pipeline.build);
+    let output = collapses
+        .triangles_at(&submesh, collapses.max_lod())
+        .into_iter()
+        .map(|t| t.map(|v| vertices[v as usize]))
+        .collect();
+    let (lo, hi) = crate::mesh::bounds_of(&submesh.positions).unwrap_or_default();
+    let centre = 0.5 * (lo + hi);
+    let radius = submesh
+        .positions
+        .iter()
+        .map(|p| p.distance(centre))
+        .fold(0f32, f32::max);
+    Built {
+        vertices,
+        model,
+        diagonal: submesh.diagonal(),
+        output,
+        centre,
+        radius,
+    }
+}
