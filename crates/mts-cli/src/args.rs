@@ -19,7 +19,7 @@ pub struct MeshSource {
     #[arg(conflicts_with = "generated")]
     pub(crate) mesh: Option<PathBuf>,
     /// Built-in mesh NAME:SIZE, SIZE in triangles (k/M suffixes):
-    /// icosphere:100k, torus:1M, grid:20k. The default when no file is given.
+    /// icosphere:100k, torus:1M, grid:20k, terrain:4M. The default when no file is given.
     #[arg(long, value_name = "NAME:SIZE")]
     pub generated: Option<Generated>,
     /// Merge vertices with identical positions.
