@@ -13,6 +13,9 @@
 //! - [`texture`]: the base-colour texture ([`Appearance`]): decoded PNG or
 //!   JPEG, or a checker; mipmapped on the CPU, RGBA8 sRGB.
 //! - [`headless`]: render to a texture, read it back, write a PNG.
+//! - [`image_error`]: how far a LoD frame is from the truth (the
+//!   full-detail frame supersampled), in units of the full-detail frame's
+//!   own error at one sample per pixel.
 //! - [`camera`]: a default camera that frames a bounding box.
 //! - [`stats`]: the adapter's own counts for a draw (vertex-shader,
 //!   clipper and fragment invocations; GPU time), where it offers them.
@@ -24,6 +27,7 @@
 pub mod camera;
 pub mod gpu;
 pub mod headless;
+pub mod image_error;
 pub mod scene;
 pub mod stats;
 pub mod strip_renderer;

@@ -90,7 +90,7 @@ fn scene_table(s: &mut String, rows: &[Scene]) {
         s,
         "\n## Scene: many instances of several models, LoD by screen-space error, shared buffers\n"
     );
-    let _ = writeln!(s, "`mts bench render --scene`'s rows on Figure 6's adapter: instances of {} ({}) scaled to one radius on a ground plane, {}×{} pixels, a camera flying through the field ({} frames). Each visible instance gets the coarsest LoD whose recorded error projects within the threshold, and draws the shared buffer of its LoD bucket (10% fewer triangles a bucket), one instanced draw per (model, bucket). Update: cull, LoD choice, extractions, uploads; frame: update and draw. GPU: peak bucket buffers and transforms, against the sum of the models' full-detail strip buffers. Image: pixels covered by instances that differ at all from the same frame at full detail ({} frames of the path).\n", first.models, first.model_names.join(", "), first.width, first.height, first.frames, first.compared_frames);
+    let _ = writeln!(s, "`mts bench render --scene`'s rows on Figure 6's adapter: instances of {} ({}) scaled to one radius on a ground plane, {}×{} pixels, a camera flying through the field ({} frames). Each visible instance gets the coarsest LoD whose recorded error projects within the threshold, and draws the shared buffer of its LoD bucket (10% fewer triangles a bucket), one instanced draw per (model, bucket). Update: cull, LoD choice, extractions, uploads; frame: update and draw. GPU: peak bucket buffers and transforms, against the sum of the models' full-detail strip buffers. Image: pixels covered by instances that differ at all from the same frame at full detail ({} frames of the path); image error: against that frame drawn 4 × 4 times denser and box-filtered (the truth), the RMSE of the LoD frame over the RMSE of the full-detail frame at one sample per pixel, sRGB values, pooled over the frames (1: as close to the truth as drawing everything).\n", first.models, first.model_names.join(", "), first.width, first.height, first.frames, first.compared_frames);
     let _ = writeln!(s, "{}", scene_table_head());
     for r in rows {
         let _ = writeln!(s, "{}", scene_table_row(r));
@@ -100,14 +100,14 @@ fn scene_table(s: &mut String, rows: &[Scene]) {
 /// The head of the scene table (the report's, and `mts bench render
 /// --scene`'s text).
 pub fn scene_table_head() -> String {
-    format!("| instances | px | visible | triangles (share of full) | draws | extractions / frame | update ms median / p99 | frame ms | CPU B / instance | GPU MB (× full strips) | buffers | pixels differing (by > {}/255; in coverage) |\n|---|---|---|---|---|---|---|---|---|---|---|---|", super::results::IMAGE_TOLERANCE)
+    format!("| instances | px | visible | triangles (share of full) | draws | extractions / frame | update ms median / p99 | frame ms | CPU B / instance | GPU MB (× full strips) | buffers | pixels differing (by > {}/255; in coverage) | image error (× full detail's) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|", super::results::IMAGE_TOLERANCE)
 }
 
 /// One scene row of [`scene_table_head`]'s table.
 pub fn scene_table_row(r: &Scene) -> String {
     let share = |x: Option<f64>| x.map_or("—".into(), |x| format!("{:.3}%", 100.0 * x));
     format!(
-        "| {} | {} | {:.0} | {:.0} ({:.2}%) | {:.1} | {:.2} | {:.2} / {:.2} | {:.1} | {} | {:.2} ({:.2}×) | {} | {} ({}; {}) |",
+        "| {} | {} | {:.0} | {:.0} ({:.2}%) | {:.1} | {:.2} | {:.2} / {:.2} | {:.1} | {} | {:.2} ({:.2}×) | {} | {} ({}; {}) | {} |",
         r.instances,
         r.pixel_threshold,
         r.visible,
@@ -125,6 +125,7 @@ pub fn scene_table_row(r: &Scene) -> String {
         share(r.differing_pixel_share),
         share(r.visibly_differing_pixel_share),
         share(r.coverage_differing_pixel_share),
+        r.image_error_ratio.map_or("—".into(), |x| format!("{x:.3}")),
     )
 }
 

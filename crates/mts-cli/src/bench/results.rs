@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 6;
+pub const SCHEMA_VERSION: u32 = 7;
 
 /// Steps (of 255) an RGB byte may move before an image comparison
 /// (Figure 6's, the scene's, the properties') counts the pixel as changed.
@@ -376,6 +376,12 @@ pub struct Scene {
     /// The same, counting only pixels covered by instances in one image
     /// and not the other (silhouettes that moved).
     pub coverage_differing_pixel_share: Option<f64>,
+    /// Over the same frames against the full-detail frame supersampled
+    /// 4 × 4 and box-filtered: the LoD frames' RMSE over the full-detail
+    /// frames' at one sample per pixel (1: as close to the truth as
+    /// drawing everything; [`mts_render::image_error`]); `null` when none
+    /// were compared.
+    pub image_error_ratio: Option<f64>,
 }
 
 /// The adapter's own vertex work per method and level, beside the cache

@@ -1,15 +1,14 @@
 //! The instanced scene measured along its camera path: frame times,
 //! triangles, LoD changes and the images against full detail (`mts bench
-//! render --scene`, the report's scene table).
-
-//! `mts bench render`: frames and triangles per second of the MTS strips
-//! against meshoptimizer-ordered triangle lists, headless, on the adapter
-//! at hand; and the cost of one LoD change (extraction plus upload).
+//! render --scene`, the report's scene table): pixels that differ, and the
+//! image-error ratio against a supersampled reference
+//! ([`mts_render::image_error`]).
 
 use crate::bench::results::Scene;
 use anyhow::Result;
 use mts::Extractor;
 use mts_render::headless::HeadlessTarget;
+use mts_render::image_error::{ImageError, ReferenceTarget};
 use mts_render::{Gpu, RendererConfig};
 use std::time::Instant;
 
@@ -42,7 +41,10 @@ fn compared_at(k: usize, n: usize) -> f32 {
 /// spread along the path the image of the instances (no ground) against
 /// the same frame at full detail (drawn once for all rows): the share of
 /// the pixels either covers whose colour differs at all, by more than
-/// [`crate::bench::results::IMAGE_TOLERANCE`], and whose coverage differs.
+/// [`crate::bench::results::IMAGE_TOLERANCE`], and whose coverage differs;
+/// and the image-error ratio ([`ImageError::ratio`], pooled over those
+/// frames): against the full-detail frame drawn 4 × 4 times denser and
+/// box-filtered, the LoD frame's RMSE over the full-detail frame's.
 ///
 /// # Errors
 /// As the scene's construction, update and drawing.
@@ -58,13 +60,21 @@ pub fn scene_rows(
     let refs: Vec<&mts::MtsModel> = models.iter().map(|(_, m)| *m).collect();
     let (width, height) = target.size();
     let (aspect, h) = (target.aspect(), height as f32);
-    let mut references = Vec::with_capacity(spec.compared_frames);
-    {
+    // Per compared frame: full detail at one sample per pixel, and the
+    // reference it is measured against with the LoD frames.
+    let mut full_frames = Vec::with_capacity(spec.compared_frames);
+    if spec.compared_frames > 0 {
         let mut full = DemoScene::new(d, q, config, &refs, spec.instances, &Default::default())?;
+        let supersampled = ReferenceTarget::new(d, width, height)?;
         for k in 0..spec.compared_frames {
             let camera = full.path_camera(compared_at(k, spec.compared_frames), aspect);
             full.update(d, q, &camera, h, 0.0)?;
-            references.push(target.render_image(d, q, |pass| full.scene.draw(pass))?);
+            let image = target.render_image(d, q, |pass| full.scene.draw(pass))?;
+            let reference = supersampled.render(&camera, |tile_camera, tile| {
+                full.update(d, q, tile_camera, h, 0.0)?;
+                tile.render_image(d, q, |pass| full.scene.draw(pass))
+            })?;
+            full_frames.push((image, reference));
         }
     }
     let full_detail_strip_bytes = models
@@ -119,10 +129,12 @@ pub fn scene_rows(
             v[((v.len() - 1) as f64 * p).round() as usize]
         };
         let mut pixels = [0f64; 4];
-        for (k, full) in references.iter().enumerate() {
+        let mut error = ImageError::default();
+        for (k, (full, reference)) in full_frames.iter().enumerate() {
             let camera = scene.path_camera(compared_at(k, spec.compared_frames), aspect);
             scene.update(d, q, &camera, h, pixel_error)?;
             let lod = target.render_image(d, q, |pass| scene.scene.draw(pass))?;
+            error.add(reference, full, &lod)?;
             let diff = full.difference(&lod, crate::bench::results::IMAGE_TOLERANCE);
             pixels[0] += diff.pixels as f64;
             pixels[1] += diff.changed_share * diff.pixels as f64;
@@ -158,6 +170,7 @@ pub fn scene_rows(
             differing_pixel_share: share(pixels[1]),
             visibly_differing_pixel_share: share(pixels[2]),
             coverage_differing_pixel_share: share(pixels[3]),
+            image_error_ratio: error.ratio(),
         });
     }
     Ok(rows)
