@@ -4,6 +4,8 @@
 //! vertex-cache order, and (feature `gltf`) a LoD chain in one glTF file
 //! read back level by level with the crate's own reader.
 
+mod common;
+
 use glam::Vec4;
 use mts::mesh::generate::Generated;
 use mts::mesh::io::{
@@ -13,25 +15,7 @@ use mts::mesh::io::{
 use mts::mesh::{Mesh, Texture};
 use mts::simplify::{simplify, Collapses, SimplifyOptions};
 use mts::strip::acmr::{fifo_acmr, CACHE_SIZE};
-use std::path::{Path, PathBuf};
-
-/// A 2 × 2 RGB PNG (red, green / blue, white).
-const PNG: &[u8] = &[
-    137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 2, 0, 0, 0, 2, 8, 2, 0,
-    0, 0, 253, 212, 154, 115, 0, 0, 0, 17, 73, 68, 65, 84, 120, 156, 99, 248, 207, 192, 192, 0,
-    194, 64, 18, 8, 0, 33, 237, 5, 251, 97, 102, 21, 174, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96,
-    130,
-];
-
-/// A fresh folder under Cargo's scratch space for integration tests.
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("export")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use std::path::Path;
 
 fn generated(name: &str) -> Generated {
     name.parse().unwrap()
@@ -55,7 +39,7 @@ fn fnv(path: &Path) -> u64 {
 /// outputs of the CLI.
 #[test]
 fn meshes_without_properties_are_written_as_before() {
-    let dir = scratch("unchanged");
+    let dir = common::scratch("export", "unchanged");
     let pins: [(&str, [u64; 4]); 3] = [
         (
             "icosphere:20k",
@@ -107,7 +91,7 @@ fn meshes_without_properties_are_written_as_before() {
 /// ```
 #[test]
 fn a_square_without_properties_is_v_and_f_lines() {
-    let dir = scratch("square");
+    let dir = common::scratch("export", "square");
     let mesh = Mesh {
         positions: vec![
             glam::Vec3::new(0.0, 0.0, 0.0),
@@ -139,10 +123,10 @@ fn textured_grid(texture: Texture) -> Mesh {
 /// `v` lines.
 #[test]
 fn obj_refers_to_a_texture_file_through_its_mtl() {
-    let dir = scratch("obj_texture_file");
+    let dir = common::scratch("export", "obj_texture_file");
     std::fs::create_dir_all(dir.join("out/images")).unwrap();
     let png = dir.join("out/images/checker.png");
-    std::fs::write(&png, PNG).unwrap();
+    std::fs::write(&png, common::PNG).unwrap();
     let mesh = textured_grid(Texture::File(png.clone()));
     let path = dir.join("out/m.obj");
     save_obj(&mesh, &path).unwrap();
@@ -180,7 +164,7 @@ fn obj_refers_to_a_texture_file_through_its_mtl() {
     std::fs::create_dir_all(dir.join("other")).unwrap();
     let path = dir.join("other/m.obj");
     save_obj(&mesh, &path).unwrap();
-    assert_eq!(std::fs::read(dir.join("other/m.png")).unwrap(), PNG);
+    assert_eq!(std::fs::read(dir.join("other/m.png")).unwrap(), common::PNG);
     assert!(std::fs::read_to_string(dir.join("other/m.mtl"))
         .unwrap()
         .ends_with("map_Kd m.png\n"));
@@ -211,14 +195,14 @@ fn corners(m: &Mesh) -> Vec<[u32; 8]> {
 /// written beside the OBJ as `<stem>.png`, white space made `_`.
 #[test]
 fn obj_writes_embedded_and_spaced_textures_beside_it() {
-    let dir = scratch("obj_texture_copy");
+    let dir = common::scratch("export", "obj_texture_copy");
     let path = dir.join("my mesh.obj");
     let embedded = textured_grid(Texture::Embedded {
         mime: String::new(),
-        bytes: PNG.to_vec(),
+        bytes: common::PNG.to_vec(),
     });
     save_obj(&embedded, &path).unwrap();
-    assert_eq!(std::fs::read(dir.join("my_mesh.png")).unwrap(), PNG);
+    assert_eq!(std::fs::read(dir.join("my_mesh.png")).unwrap(), common::PNG);
     assert_eq!(
         std::fs::read_to_string(dir.join("my mesh.mtl")).unwrap(),
         "newmtl textured\nKd 1 1 1\nmap_Kd my_mesh.png\n"
@@ -230,11 +214,11 @@ fn obj_writes_embedded_and_spaced_textures_beside_it() {
     );
 
     std::fs::create_dir_all(dir.join("a b")).unwrap();
-    std::fs::write(dir.join("a b/t.png"), PNG).unwrap();
+    std::fs::write(dir.join("a b/t.png"), common::PNG).unwrap();
     std::fs::remove_file(dir.join("my_mesh.png")).unwrap();
     let spaced = textured_grid(Texture::File(dir.join("a b/t.png")));
     save_obj(&spaced, &path).unwrap();
-    assert_eq!(std::fs::read(dir.join("my_mesh.png")).unwrap(), PNG);
+    assert_eq!(std::fs::read(dir.join("my_mesh.png")).unwrap(), common::PNG);
     assert!(std::fs::read_to_string(dir.join("my mesh.mtl"))
         .unwrap()
         .ends_with("map_Kd my_mesh.png\n"));
@@ -245,14 +229,14 @@ fn obj_writes_embedded_and_spaced_textures_beside_it() {
 /// outside the PLY's folder is copied the same way.
 #[test]
 fn ply_writes_an_embedded_texture_beside_it() {
-    let dir = scratch("ply_texture");
+    let dir = common::scratch("export", "ply_texture");
     let mesh = textured_grid(Texture::Embedded {
         mime: "image/png".into(),
-        bytes: PNG.to_vec(),
+        bytes: common::PNG.to_vec(),
     });
     let path = dir.join("g.ply");
     save_ply(&mesh, &path).unwrap();
-    assert_eq!(std::fs::read(dir.join("g.png")).unwrap(), PNG);
+    assert_eq!(std::fs::read(dir.join("g.png")).unwrap(), common::PNG);
     let (back, _) = load(&path, with_properties()).unwrap();
     assert_eq!(
         back.properties.texture,
@@ -266,7 +250,7 @@ fn ply_writes_an_embedded_texture_beside_it() {
     let outside = textured_grid(Texture::File(dir.join("g.png")));
     let path = dir.join("out/h.ply");
     save_ply(&outside, &path).unwrap();
-    assert_eq!(std::fs::read(dir.join("out/h.png")).unwrap(), PNG);
+    assert_eq!(std::fs::read(dir.join("out/h.png")).unwrap(), common::PNG);
     let (back, _) = load(&path, with_properties()).unwrap();
     assert_eq!(
         back.properties.texture,
@@ -456,7 +440,7 @@ mod gltf_chain {
         let mut mesh = generated("torus:4k").build_with_properties();
         mesh.properties.texture = Some(Texture::Embedded {
             mime: "image/png".into(),
-            bytes: PNG.to_vec(),
+            bytes: common::PNG.to_vec(),
         });
         let collapses = simplify(&mesh, &SimplifyOptions::default()).collapses;
         let lods = chain_lods(&collapses);
@@ -466,7 +450,7 @@ mod gltf_chain {
 
     #[test]
     fn a_chain_reads_back_level_by_level() {
-        let dir = scratch("chain");
+        let dir = common::scratch("export", "chain");
         let (mesh, lods, levels) = textured_chain();
         assert_eq!(lods.len(), 5, "{lods:?}");
         let path = dir.join("chain.glb");
@@ -554,7 +538,7 @@ mod gltf_chain {
 
     #[test]
     fn bad_chains_are_refused() {
-        let dir = scratch("bad_chain");
+        let dir = common::scratch("export", "bad_chain");
         let (_, _, mut levels) = textured_chain();
         let path = dir.join("c.glb");
         assert!(save_lod_chain(&[], &Coverage::default(), &path).is_err());
@@ -579,10 +563,10 @@ mod gltf_chain {
     /// A textured `.glb` round trip: material, texture and streams back.
     #[test]
     fn a_textured_glb_keeps_its_material_and_texture() {
-        let dir = scratch("textured_glb");
+        let dir = common::scratch("export", "textured_glb");
         let mesh = textured_grid(Texture::Embedded {
             mime: "image/png".into(),
-            bytes: PNG.to_vec(),
+            bytes: common::PNG.to_vec(),
         });
         let path = dir.join("g.glb");
         save_gltf(&mesh, &path).unwrap();
@@ -617,7 +601,7 @@ mod gltf_chain {
     /// normal: glTF normals are unit length.
     #[test]
     fn zero_normals_are_written_as_face_normals() {
-        let dir = scratch("zero_normals");
+        let dir = common::scratch("export", "zero_normals");
         let mut mesh = generated("grid:50").build_with_properties();
         mesh.properties.normals.as_mut().unwrap()[7] = glam::Vec3::ZERO;
         let path = dir.join("z.glb");
@@ -637,7 +621,7 @@ mod gltf_chain {
     /// `.bin`; recorded from the writer of commit b2814bc).
     #[test]
     fn gltf_outputs_are_unchanged() {
-        let dir = scratch("gltf_unchanged");
+        let dir = common::scratch("export", "gltf_unchanged");
         let pins = [
             (
                 "torus:5k",

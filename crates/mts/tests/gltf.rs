@@ -4,31 +4,15 @@
 //! error the reader promises a place for, matched by variant and place.
 //! The shared models hold no glTF, so every asset is made here.
 
+mod common;
+
 use glam::{Vec2, Vec3, Vec4};
 use mts::mesh::generate::torus;
 use mts::mesh::io::{load, parse_gltf, parse_gltf_with, save_gltf, Format, LoadOptions};
 use mts::mesh::{Mesh, RawMesh, Texture};
 use mts::{Error, Place};
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
-
-/// A 2 × 2 RGB PNG (red, green / blue, white).
-const PNG: &[u8] = &[
-    137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 2, 0, 0, 0, 2, 8, 2, 0,
-    0, 0, 253, 212, 154, 115, 0, 0, 0, 17, 73, 68, 65, 84, 120, 156, 99, 248, 207, 192, 192, 0,
-    194, 64, 18, 8, 0, 33, 237, 5, 251, 97, 102, 21, 174, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96,
-    130,
-];
-
-/// A fresh folder under Cargo's scratch space for integration tests.
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("gltf")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use std::path::Path;
 
 /// A torus with unit normals, texture coordinates on a 1/4096 grid (the
 /// `v` flip is exact there), colours in 0..=1 and `texture`.
@@ -92,10 +76,10 @@ fn read_back(path: &Path) -> RawMesh {
 
 #[test]
 fn glb_round_trip_keeps_every_property_to_the_bit() {
-    let dir = scratch("glb_round_trip");
+    let dir = common::scratch("gltf", "glb_round_trip");
     let texture = Texture::Embedded {
         mime: "image/png".into(),
-        bytes: PNG.to_vec(),
+        bytes: common::PNG.to_vec(),
     };
     let mesh = textured_torus(24, 12, Some(texture.clone()));
     let path = dir.join("torus.glb");
@@ -111,8 +95,8 @@ fn glb_round_trip_keeps_every_property_to_the_bit() {
 
 #[test]
 fn gltf_round_trip_keeps_every_property_and_the_texture_file() {
-    let dir = scratch("gltf_round_trip");
-    std::fs::write(dir.join("skin.png"), PNG).unwrap();
+    let dir = common::scratch("gltf", "gltf_round_trip");
+    std::fs::write(dir.join("skin.png"), common::PNG).unwrap();
     let texture = Texture::File(dir.join("skin.png"));
     let mesh = textured_torus(24, 12, Some(texture.clone()));
     let path = dir.join("torus.gltf");
@@ -129,7 +113,7 @@ fn gltf_round_trip_keeps_every_property_and_the_texture_file() {
     // An embedded image stays embedded in the .gltf's buffer.
     let embedded = Texture::Embedded {
         mime: String::new(),
-        bytes: PNG.to_vec(),
+        bytes: common::PNG.to_vec(),
     };
     let mesh = textured_torus(5, 4, Some(embedded));
     save_gltf(&mesh, &path).unwrap();
@@ -137,7 +121,7 @@ fn gltf_round_trip_keeps_every_property_and_the_texture_file() {
         read_back(&path).properties.texture,
         Some(Texture::Embedded {
             mime: "image/png".into(),
-            bytes: PNG.to_vec()
+            bytes: common::PNG.to_vec()
         })
     );
 }
@@ -146,18 +130,18 @@ fn gltf_round_trip_keeps_every_property_and_the_texture_file() {
 /// refers to it by a relative path.
 #[test]
 fn texture_files_are_embedded_in_glb_and_referred_to_from_gltf() {
-    let dir = scratch("texture_files");
+    let dir = common::scratch("gltf", "texture_files");
     std::fs::create_dir_all(dir.join("images")).unwrap();
     std::fs::create_dir_all(dir.join("out")).unwrap();
     let png = dir.join("images/a b.png");
-    std::fs::write(&png, PNG).unwrap();
+    std::fs::write(&png, common::PNG).unwrap();
     let mesh = textured_torus(6, 5, Some(Texture::File(png.clone())));
     save_gltf(&mesh, &dir.join("out/t.glb")).unwrap();
     assert_eq!(
         read_back(&dir.join("out/t.glb")).properties.texture,
         Some(Texture::Embedded {
             mime: "image/png".into(),
-            bytes: PNG.to_vec()
+            bytes: common::PNG.to_vec()
         })
     );
     save_gltf(&mesh, &dir.join("out/t.gltf")).unwrap();
@@ -174,7 +158,7 @@ fn texture_files_are_embedded_in_glb_and_referred_to_from_gltf() {
 /// other attribute and no material.
 #[test]
 fn large_mesh_round_trips_with_u32_indices() {
-    let dir = scratch("large");
+    let dir = common::scratch("gltf", "large");
     let mesh = torus(300, 250);
     let path = dir.join("big.glb");
     save_gltf(&mesh, &path).unwrap();
@@ -191,7 +175,7 @@ fn large_mesh_round_trips_with_u32_indices() {
 /// an ulp of 1.0.
 #[test]
 fn arbitrary_texture_coordinates_come_back_within_half_an_ulp_of_one() {
-    let dir = scratch("uv_rounding");
+    let dir = common::scratch("gltf", "uv_rounding");
     let mut mesh = torus(7, 5);
     let uvs: Vec<Vec2> = (0..mesh.positions.len())
         .map(|i| Vec2::splat(0.1 + i as f32 * 1e-3))
@@ -247,27 +231,6 @@ impl Bin {
     }
 }
 
-fn base64(bytes: &[u8]) -> String {
-    const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for group in bytes.chunks(3) {
-        let b = [
-            group[0],
-            *group.get(1).unwrap_or(&0),
-            *group.get(2).unwrap_or(&0),
-        ];
-        let n = u32::from(b[0]) << 16 | u32::from(b[1]) << 8 | u32::from(b[2]);
-        for k in 0..4 {
-            if k <= group.len() {
-                out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
-}
-
 /// A buffer view over `(offset, length)` of buffer 0.
 fn view((offset, length): (usize, usize)) -> Value {
     json!({ "buffer": 0, "byteOffset": offset, "byteLength": length })
@@ -287,7 +250,7 @@ fn gltf_text(bin: &Bin, mut body: Value) -> Vec<u8> {
     body["asset"] = json!({ "version": "2.0" });
     body["buffers"] = json!([{
         "byteLength": bin.0.len(),
-        "uri": format!("data:application/octet-stream;base64,{}", base64(&bin.0)),
+        "uri": format!("data:application/octet-stream;base64,{}", common::base64(&bin.0)),
     }]);
     serde_json::to_vec(&body).unwrap()
 }
@@ -464,7 +427,7 @@ fn missing_attributes_are_filled_with_neutral_values() {
 /// one is an I/O error naming that file.
 #[test]
 fn external_buffers_are_read_beside_the_file() {
-    let dir = scratch("external");
+    let dir = common::scratch("gltf", "external");
     let mut bin = Bin::default();
     let mut body = triangle_asset(&mut bin);
     body["asset"] = json!({ "version": "2.0" });
@@ -779,7 +742,7 @@ fn object(element: &str) -> Place {
 fn indices_of_2_to_the_32_or_more_are_refused_at_their_field() {
     let mut bin = Bin::default();
     let mut base = triangle_asset(&mut bin);
-    let png = bin.put(PNG);
+    let png = bin.put(common::PNG);
     base["bufferViews"].as_array_mut().unwrap().push(view(png));
     base["nodes"] = json!([{ "mesh": 0 }]);
     base["scenes"] = json!([{ "nodes": [0] }]);

@@ -195,11 +195,23 @@ pub fn torus(major: u32, minor: u32) -> Mesh {
 #[must_use]
 pub fn grid(columns: u32, rows: u32) -> Mesh {
     assert!(columns > 0 && rows > 0, "grid needs at least one quad");
-    let w = columns + 1;
     let positions = (0..=rows)
         .flat_map(|y| (0..=columns).map(move |x| Vec3::new(x as f32, y as f32, 0.0)))
         .collect();
-    let mut triangles = Vec::with_capacity(2 * (columns * rows) as usize);
+    Mesh {
+        positions,
+        triangles: quad_triangles(columns, rows),
+        properties: Default::default(),
+    }
+}
+
+/// The triangles of a `columns × rows` grid of quads over vertices laid
+/// out row by row (`columns + 1` a row): each quad split along the same
+/// diagonal, counter-clockwise seen from the side the rows advance to the
+/// left of the columns (what `grid` and the terrain share).
+fn quad_triangles(columns: u32, rows: u32) -> Vec<[u32; 3]> {
+    let w = columns + 1;
+    let mut triangles = Vec::with_capacity(2 * columns as usize * rows as usize);
     for y in 0..rows {
         for x in 0..columns {
             let a = y * w + x;
@@ -207,11 +219,7 @@ pub fn grid(columns: u32, rows: u32) -> Mesh {
             triangles.push([a, a + w + 1, a + w]);
         }
     }
-    Mesh {
-        positions,
-        triangles,
-        properties: Default::default(),
-    }
+    triangles
 }
 
 /// Relief of [`terrain`]: its heights span exactly `0..=TERRAIN_RELIEF`,
@@ -273,18 +281,9 @@ pub fn terrain(side: u32, seed: u64) -> Mesh {
     for p in &mut positions {
         p.y = ((p.y - lo) * scale).min(TERRAIN_RELIEF);
     }
-    let w = w as u32;
-    let mut triangles = Vec::with_capacity(2 * (side as usize).pow(2));
-    for j in 0..side {
-        for i in 0..side {
-            let a = j * w + i;
-            triangles.push([a, a + 1, a + w + 1]);
-            triangles.push([a, a + w + 1, a + w]);
-        }
-    }
     Mesh {
         positions,
-        triangles,
+        triangles: quad_triangles(side, side),
         properties: Default::default(),
     }
 }
