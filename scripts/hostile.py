@@ -10,8 +10,9 @@ Commands
 CI slice (fixed seed 19, timeout 10 s): the issue-19 families' 600 inputs
 (about 1,700 runs; no heavy extreme mesh, no argument that is slow even
 when handled right, one render run), the same inputs as before issue 31,
-then a fixed slice of each issue-31 family (161 inputs, about 300 runs:
-QUICK_SLICE); about 30 s on 2 cores with a sound binary::
+then a fixed slice of each issue-31 family (161 inputs, about 300 runs)
+and of the issue-33 one, hier (24 inputs, 72 runs: QUICK_SLICE); about
+50 s on 2 cores with a sound binary::
 
     python3 scripts/hostile.py --mts target/release/mts --quick
 
@@ -24,11 +25,11 @@ each hang adds up to --timeout)::
 The issue-31 families alone (the figure in its closing note)::
 
     python3 scripts/hostile.py --mts target/release/mts \
-        --families gltf,amplify,fifo,output,view,props,reseal --count 600
+        --families gltf,amplify,fifo,output,view,props,reseal,hier --count 600
 
 Other options: --seed N, --count N (inputs), --timeout S (20), --mem-gb G (4),
 --families obj,ply,mts,stream,args,extreme,gltf,amplify,fifo,output,view,
-props,reseal, --jobs N (2), --list-limit N. The same seed, count and
+props,reseal,hier, --jobs N (2), --list-limit N. The same seed, count and
 --families give the same inputs whatever --jobs says (each input is drawn
 from its own generator, seeded by seed and index). With --quick, --families
 picks among the slices (the issue-19 ones share 600 inputs as before).
@@ -178,11 +179,22 @@ reseal   version-3 files (torus, optimal icosphere, one-band grid, torus
          (a mismatch, or a refusal at load), `info` and `extract --ratio` /
          `--lod` must refuse too (else garbage accepted). A changed LoD ->
          triangle table must be refused by all four.
+hier     version-4 files (`build --hierarchy`: a terrain, a torus with
+         properties and seams; V4File) truncated, flipped, resealed
+         flipped, and with one field changed and the file resealed: a HIER
+         count +-1 or huge, a section's length, tag, trailing bytes,
+         version (3, 5, ...) and section count; per group its record's
+         length +-1, a list count huge, a NaN radius or floor, another
+         floor, an input cluster, its children, the own-vertices flag (all
+         refused by `info` and `verify`); a vertex-map entry or a flip in
+         a group's model sections (possibly valid: `verify` sweeps
+         cameras for cracks). `extract` must refuse every one (a
+         hierarchy is not a model) naming the file.
 
 Checksums (read from src/model/format.rs and src/baselines/cluster/stream.rs):
 .mts: header "MTSMODEL" | version u32 | section count u32 | file length u64
 | FNV-1a/64 (offset basis 0xcbf29ce484222325, prime 0x100000001b3) of every
-byte after the 32-byte header (version 3: its four-lane word form,
+byte after the 32-byte header (versions 3 and 4: its four-lane word form,
 checksum::fnv1a64_words), stored at bytes 24..32. Stream: "MTSCT\\0\\0\\x01"
 | vertices, triangles, roots, base triangles (u32 LE each) | FNV-1a/32
 (0x811c9dc5, 0x01000193) of the body after the 28-byte header at bytes
@@ -255,17 +267,18 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 
-# The issue-19 families, then the issue-31 ones.
+# The issue-19 families, then the issue-31 ones (and issue 33's hier).
 OLD_FAMILIES = ["obj", "ply", "mts", "stream", "args", "extreme"]
-NEW_FAMILIES = ["gltf", "amplify", "fifo", "output", "view", "props", "reseal"]
+NEW_FAMILIES = ["gltf", "amplify", "fifo", "output", "view", "props", "reseal", "hier"]
 FAMILIES = OLD_FAMILIES + NEW_FAMILIES
 # Share of the inputs per family.
 WEIGHTS = {"obj": 26, "ply": 25, "mts": 19, "stream": 15, "extreme": 9, "args": 6,
-           "gltf": 14, "amplify": 1, "fifo": 2, "output": 6, "view": 2, "props": 3, "reseal": 9}
+           "gltf": 14, "amplify": 1, "fifo": 2, "output": 6, "view": 2, "props": 3, "reseal": 9, "hier": 6}
 DEFAULT_COUNT = 3700
 QUICK_COUNT = 600  # the issue-19 families' share of --quick
 # --quick: a fixed slice of each issue-31 family, after those 600 inputs.
-QUICK_SLICE = {"gltf": 36, "amplify": 4, "fifo": 10, "output": 64, "view": 10, "props": 13, "reseal": 24}
+QUICK_SLICE = {"gltf": 36, "amplify": 4, "fifo": 10, "output": 64, "view": 10, "props": 13, "reseal": 24,
+               "hier": 24}
 QUICK_SEED = 19
 QUICK_TIMEOUT = 10
 
@@ -3400,6 +3413,268 @@ def gen_reseal(rng, seeds, index, quick=False):
     return case
 
 
+# --- version-4 files: hierarchies ---------------------------------------------
+
+
+class V4File:
+    """A version-4 .mts file (a hierarchy, crates/mts/src/hierarchy/format.rs)
+    cut into sections, its HIER counts decoded and its GRPS section cut into
+    group records, each record's layout found."""
+
+    TAGS = [b"HIER", b"POSI", b"PROP", b"CLUS", b"CTRI", b"CSTR", b"GRPS"]
+
+    def __init__(self, data):
+        self.version, count = struct.unpack_from("<II", data, 8)
+        if self.version != 4 or count != 7:
+            raise ValueError("not a version-4 file")
+        pos = MTS_HEADER
+        self.sections = []
+        for _ in range(count):
+            tag = bytes(data[pos : pos + 4])
+            n = struct.unpack_from("<Q", data, pos + 4)[0]
+            self.sections.append([tag, bytes(data[pos + 12 : pos + 12 + n])])
+            pos += 12 + n
+        if pos != len(data):
+            raise ValueError("sections do not end at the end of the file")
+        if [t for t, _ in self.sections] != self.TAGS:
+            raise ValueError("sections %s" % [t for t, _ in self.sections])
+        hier = self.sections[0][1]
+        p = 0
+        self.counts = []
+        for _ in range(6):
+            v, p = get_varint(hier, p)
+            self.counts.append(v)
+        if p != len(hier):
+            raise ValueError("HIER has %d bytes, 6 varints %d" % (len(hier), p))
+        grps = self.sections[6][1]
+        p = 0
+        self.groups = []
+        while p < len(grps):
+            n = struct.unpack_from("<Q", grps, p)[0]
+            self.groups.append(bytearray(grps[p + 8 : p + 8 + n]))
+            p += 8 + n
+        if len(self.groups) != self.counts[5]:
+            raise ValueError("%d group records for %d groups" % (len(self.groups), self.counts[5]))
+        self.len_delta = {}
+        self.trailing = b""
+        self.section_count = 7
+
+    @staticmethod
+    def layout(record):
+        """Offsets in a group record: level, the six floats, the three
+        lists (count offset, value offsets), the vertex map (count offset,
+        value offsets), the flag, the model sections [tag, start, length]."""
+        out = {}
+        _, p = get_varint(record, 0)
+        out["floats"] = p
+        p += 24
+        out["lists"] = []
+        for _ in range(4):
+            at = p
+            n, p = get_varint(record, p)
+            values = []
+            for _ in range(n):
+                values.append(p)
+                _, p = get_varint(record, p)
+            out["lists"].append((at, values))
+        out["flag"] = p
+        p += 1
+        out["model"] = []
+        while p < len(record):
+            tag = bytes(record[p : p + 4])
+            n = struct.unpack_from("<Q", record, p + 4)[0]
+            out["model"].append([tag, p + 12, n])
+            p += 12 + n
+        if p != len(record):
+            raise ValueError("a group's model sections overrun its record")
+        return out
+
+    def to_bytes(self):
+        hier = bytearray()
+        for c in self.counts:
+            put_varint(hier, c)
+        self.sections[0][1] = bytes(hier)
+        grps = bytearray()
+        for r in self.groups:
+            grps += struct.pack("<Q", len(r)) + bytes(r)
+        self.sections[6][1] = bytes(grps)
+        body = bytearray()
+        for i, (tag, payload) in enumerate(self.sections):
+            n = max(0, len(payload) + self.len_delta.get(i, 0))
+            body += tag + struct.pack("<Q", n & 0xFFFFFFFFFFFFFFFF) + payload
+        head = b"MTSMODEL" + struct.pack("<II", self.version, self.section_count) + struct.pack("<QQ", 0, 0)
+        return seal_mts(head + bytes(body) + self.trailing)
+
+
+def set_varint_at(record, at, value):
+    """record (bytearray) with the varint at `at` replaced by `value`."""
+    _, end = get_varint(record, at)
+    v = bytearray()
+    put_varint(v, value)
+    record[at:end] = v
+
+
+HIER_SEEDS = ("terrain_h.mts", "torus_props_h.mts")
+HIER_KINDS = ["truncate", "flip", "reseal_flip", "hier_count", "hier_count_huge", "section_len", "tag", "trailing",
+              "version", "section_count", "group_len", "group_list_huge", "group_nan", "group_floor",
+              "group_input", "group_child", "group_flag", "group_map", "group_model_flip", "clean"]
+# Edits that may leave a valid hierarchy (another one, or one that draws
+# other vertices: verify's camera sweep may find its cracks).
+HIER_UNKNOWN = ("reseal_flip", "group_map", "group_model_flip")
+
+
+def hier_edit(rng, f, kind):
+    """Applies `kind` to a parsed V4File in place; returns a label, or None
+    when it has nothing to change."""
+    g = rng.randrange(len(f.groups))
+    r = f.groups[g]
+    lay = V4File.layout(r)
+    if kind == "hier_count":
+        i = rng.randrange(6)
+        d = rng.choice([-1, 1, 2])
+        if f.counts[i] + d < 0:
+            d = 1
+        f.counts[i] += d
+        return "count%d%+d" % (i, d)
+    if kind == "hier_count_huge":
+        i = rng.randrange(6)
+        f.counts[i] = rng.choice([2 ** 28, 2 ** 32 - 1, 2 ** 40, 2 ** 64 - 1])
+        return "count%d" % i
+    if kind == "section_len":
+        i = rng.randrange(7)
+        f.len_delta[i] = rng.choice([-1, 1, 7, 2 ** 40, 2 ** 63])
+        return "section%d" % i
+    if kind == "tag":
+        i = rng.randrange(7)
+        f.sections[i][0] = rng.choice([b"XXXX", b"hier", b"MODL", b"\x00\x00\x00\x00", f.TAGS[(i + 1) % 7]])
+        return "section%d" % i
+    if kind == "trailing":
+        f.trailing = bytes(rng.randrange(256) for _ in range(rng.randint(1, 16)))
+        return "trailing"
+    if kind == "version":
+        f.version = rng.choice([0, 1, 2, 3, 5, 255, 2 ** 32 - 1])
+        return "v%d" % f.version
+    if kind == "section_count":
+        f.section_count = rng.choice([0, 6, 8, 2 ** 32 - 1])
+        return "sections%d" % f.section_count
+    if kind == "group_len":
+        # One byte moved between two records (or out of the last).
+        d = rng.choice([-1, 1])
+        if d < 0:
+            f.groups[g] = r[:-1]
+            if g + 1 < len(f.groups):
+                f.groups[g + 1] = r[-1:] + f.groups[g + 1]
+            else:
+                f.trailing = b""
+                f.len_delta[6] = 1
+        elif g + 1 < len(f.groups) and f.groups[g + 1]:
+            f.groups[g] = r + f.groups[g + 1][:1]
+            f.groups[g + 1] = f.groups[g + 1][1:]
+        else:
+            f.groups[g] = r + b"\x00"
+        return "group%d%+d" % (g, d)
+    if kind == "group_list_huge":
+        i = rng.randrange(4)
+        set_varint_at(r, lay["lists"][i][0], rng.choice([2 ** 28, 2 ** 32 - 1, 2 ** 40, 2 ** 64 - 1]))
+        return "group%d:list%d" % (g, i)
+    if kind == "group_nan":
+        k = rng.choice([0, 1, 2, 5])  # floor, diagonal, centre.x, radius
+        v = rng.choice([float("nan"), float("inf"), -float("inf"), -1.0]) if k != 2 else float("nan")
+        struct.pack_into("<f", r, lay["floats"] + 4 * k, v)
+        return "group%d:float%d" % (g, k)
+    if kind == "group_floor":
+        old = struct.unpack_from("<f", r, lay["floats"])[0]
+        struct.pack_into("<f", r, lay["floats"], old * 2 + 1)
+        return "group%d:floor" % g
+    if kind == "group_input":
+        at, values = lay["lists"][0]
+        if not values:
+            return None
+        k = rng.randrange(len(values))
+        old, _ = get_varint(r, values[k])
+        new = rng.choice([old + 1, max(0, old - 1), f.counts[2], f.counts[2] + 5, 0])
+        if new == old:
+            return None
+        set_varint_at(r, values[k], new)
+        return "group%d:input%d" % (g, k)
+    if kind == "group_child":
+        at, values = lay["lists"][2]
+        if values:
+            # One child fewer.
+            del r[values[-1] : lay["lists"][3][0]]
+            set_varint_at(r, at, len(values) - 1)
+            return "group%d:child-" % g
+        if g == 0:
+            return None
+        set_varint_at(r, at, 1)
+        tail = bytearray()
+        put_varint(tail, rng.randrange(g))
+        r[at + 1 : at + 1] = tail
+        return "group%d:child+" % g
+    if kind == "group_flag":
+        r[lay["flag"]] = rng.choice([1, 2, 255])
+        return "group%d:flag" % g
+    if kind == "group_map":
+        at, values = lay["lists"][3]
+        if not values:
+            return None
+        k = rng.randrange(len(values))
+        delta, _ = get_varint(r, values[k])
+        new = zigzag(unzigzag(delta) + rng.choice([-1, 1]))
+        set_varint_at(r, values[k], new)
+        return "group%d:map%d" % (g, k)
+    if kind == "group_model_flip":
+        tag, start, n = rng.choice(lay["model"])
+        if n == 0:
+            return None
+        i = start + rng.randrange(n)
+        r[i] ^= rng.randrange(1, 256)
+        return "group%d:%s" % (g, tag.decode(errors="replace"))
+    raise ValueError(kind)
+
+
+def gen_hier(rng, seeds, index, quick=False):
+    name = HIER_SEEDS[index % len(HIER_SEEDS)]
+    full = seeds.v4[name]
+    kind = HIER_KINDS[index % len(HIER_KINDS)] if quick else rng.choice(HIER_KINDS)
+    label, data = kind, None
+    if kind == "truncate":
+        data = truncate(rng, full)
+    elif kind == "flip":
+        data, _ = flip(rng, full)
+    elif kind == "reseal_flip":
+        data = seal_mts(flip(rng, full, start=MTS_HEADER)[0])
+    elif kind != "clean":
+        for _ in range(20):
+            f = V4File(full)
+            label = hier_edit(rng, f, kind)
+            if label:
+                data = f.to_bytes()
+                break
+    if data is None:
+        kind = label = "clean"
+        data = full
+    expect = ACCEPT if kind == "clean" else UNKNOWN if kind in HIER_UNKNOWN else GARBAGE
+    case = Case("hier", "%s/%s:%s" % (kind, name[:-4], label), ".mts", data)
+    # verify decides whether a possibly valid edit lies (a crack, a group's
+    # model against its replay): one that info loads is then a "trusted
+    # lie", counted apart, as in the reseal family.
+    case.run(["verify", "{in}", "--lods", "2"], expect)
+    refused = ("clean error", "unnamed error", "valid refused", "wrong message")
+
+    def by_verify(prev):
+        if expect != UNKNOWN:
+            return expect
+        return TRUSTED if prev[0]["cls"] in refused else UNKNOWN
+
+    case.run(["info", "{in}", "--json"] if rng.random() < 0.3 else ["info", "{in}"], by_verify)
+    # A hierarchy is not a model: the model's commands refuse every one.
+    case.run(rng.choice([["extract", "{in}", "--lod", "0", "--repeat", "1"],
+                         ["extract", "{in}", "--ratio", "0.5", "--repeat", "1"],
+                         ["extract", "{in}", "--triangles", "100", "--repeat", "1", "--json"]]), GARBAGE)
+    return case
+
+
 # --------------------------------------------------------------------------
 # Running and classifying
 
@@ -3434,12 +3709,15 @@ def make_seeds(mts_bin, root, timeout):
         # The reseal family's (issue 31): a single band, and properties.
         "grid_single_v3.mts": ["build", "--generated", "grid:60", "--single-band", "-o"],
         "torus_props_v3.mts": ["build", "--generated", "torus:300", "--properties", "-o"],
+        # The hier family's: version-4 hierarchies.
+        "terrain_h.mts": ["build", "--generated", "terrain:2k", "--hierarchy", "-o"],
+        "torus_props_h.mts": ["build", "--generated", "torus:1k", "--properties", "--hierarchy", "-o"],
         "torus.stream": ["encode", "--generated", "torus:200", "-o"],
         "ico.stream": ["encode", "--generated", "icosphere:80", "-o"],
         "grid.stream": ["encode", "--generated", "grid:32", "-o"],
         "cube.stream": ["encode", cube, "-o"],
     }
-    s.mts, s.stream, s.v3 = {}, {}, {}
+    s.mts, s.stream, s.v3, s.v4 = {}, {}, {}, {}
     for name, argv in jobs.items():
         out = os.path.join(s.dir, name)
         p = subprocess.run([mts_bin] + argv + [out], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
@@ -3450,6 +3728,8 @@ def make_seeds(mts_bin, root, timeout):
             data = f.read()
         if name in RESEAL_ONLY:
             s.v3[name] = data
+        elif name in HIER_SEEDS:
+            s.v4[name] = data
         else:
             (s.mts if name.endswith(".mts") else s.stream)[name] = data
     for name, data in list(s.mts.items()) + list(s.v3.items()):
@@ -3464,6 +3744,13 @@ def make_seeds(mts_bin, root, timeout):
                 raise RuntimeError("seed %s: taking the version-3 file apart and back changes it" % name)
         if seal_mts(data) != data:
             raise RuntimeError("seed %s: resealing changes it; the .mts checksum is not the one of its version" % name)
+    for name, data in s.v4.items():
+        try:
+            f = V4File(data)
+        except (ValueError, struct.error, IndexError) as e:
+            raise RuntimeError("seed %s: the version-4 layout is not the one this harness knows: %s" % (name, e))
+        if f.to_bytes() != data:
+            raise RuntimeError("seed %s: taking the version-4 file apart and back changes it" % name)
     for name, data in s.stream.items():
         if seal_stream(data) != data:
             raise RuntimeError("seed %s: resealing changes it; the stream checksum is not FNV-1a/32" % name)
@@ -3491,7 +3778,7 @@ def build_case(seed, index, family, seeds, family_index, render_budget, quick=Fa
     if family == "extreme":
         return gen_extreme(rng, seeds, family_index, quick)
     gen = {"gltf": gen_gltf, "amplify": gen_amplify, "fifo": gen_fifo, "output": gen_output, "view": gen_view,
-           "props": gen_props, "reseal": gen_reseal}[family]
+           "props": gen_props, "reseal": gen_reseal, "hier": gen_hier}[family]
     return gen(rng, seeds, family_index, quick)
 
 

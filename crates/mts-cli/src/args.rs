@@ -109,14 +109,25 @@ impl MeshSource {
         self.load_with(!self.positions_only)
     }
 
+    /// [`MeshSource::load`] with `g` as the built-in mesh when neither a
+    /// file nor `--generated` is given (a command whose default input is
+    /// not [`Generated::DEFAULT`]).
+    pub fn load_generated(&self, g: Generated) -> Result<(String, Mesh, CleanReport)> {
+        self.load_or(!self.positions_only, g)
+    }
+
     fn load_with(&self, properties: bool) -> Result<(String, Mesh, CleanReport)> {
+        self.load_or(properties, Generated::DEFAULT)
+    }
+
+    fn load_or(&self, properties: bool, default: Generated) -> Result<(String, Mesh, CleanReport)> {
         let clean = CleanOptions { weld: self.weld };
         if let Some(path) = &self.mesh {
             let (mesh, report) =
                 load(path, self.load_options_with(properties)).context("cannot load the mesh")?;
             Ok((path.display().to_string(), mesh, report))
         } else {
-            let g = self.generated.unwrap_or(Generated::DEFAULT);
+            let g = self.generated.unwrap_or(default);
             let mesh = if self.properties && properties {
                 g.build_with_properties()
             } else {

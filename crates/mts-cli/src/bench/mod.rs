@@ -10,7 +10,8 @@
 //! `report` `results`, `charts` and the constants of `measure`; `summary`
 //! `report`; the measuring files (`measure`, `methods`, `figure6`,
 //! `scene`, `vertex_work`) `results` and each other, never the Markdown;
-//! `render` (the `bench render` command) the measuring and `report`.
+//! `render` (the `bench render` command) the measuring and `report`;
+//! `view_dependent` (`mts bench view-dependent`) none of the others.
 
 pub mod charts;
 pub mod check;
@@ -23,3 +24,4 @@ pub mod results;
 pub mod scene;
 pub mod summary;
 pub mod vertex_work;
+pub mod view_dependent;

@@ -12,6 +12,11 @@ pub enum BenchCommand {
     /// Frames and triangles per second: MTS strips against
     /// meshoptimizer-ordered triangle lists at 100%, 50% and 10%.
     Render(crate::bench::render::BenchRenderArgs),
+    /// Detail per region along a fixed flight: the strip hierarchy against
+    /// meshoptimizer's cluster LoD, the cluster tree and the per-object
+    /// model (triangles, indices, update time, cracks, popping, memory,
+    /// image error).
+    ViewDependent(crate::bench::view_dependent::BenchViewDependentArgs),
     /// The README's "Latest bench report" section, made from a report's
     /// results.json.
     Summary(SummaryArgs),
@@ -137,6 +142,9 @@ pub struct BenchArgs {
 pub fn run(args: &BenchArgs) -> Result<()> {
     match &args.command {
         Some(BenchCommand::Render(args)) => return crate::bench::render::bench_render(args),
+        Some(BenchCommand::ViewDependent(args)) => {
+            return crate::bench::view_dependent::bench_view_dependent(args)
+        }
         Some(BenchCommand::Summary(args)) => return bench_summary(args),
         Some(BenchCommand::Check(args)) => return bench_check(args),
         None => {}

@@ -1,4 +1,5 @@
-//! `mts build`: build the MTS model and write it as an `.mts` file.
+//! `mts build`: build the MTS model (or, with `--hierarchy`, the
+//! view-dependent hierarchy) and write it as an `.mts` file.
 
 use crate::args::*;
 use crate::stdout::{outln, warnln};
@@ -41,6 +42,13 @@ pub struct BuildArgs {
     /// instead of a few).
     #[arg(long)]
     pub recipe_only: bool,
+    /// Build the view-dependent hierarchy instead (mts::hierarchy: a DAG
+    /// of cluster groups, each a multiresolution strip model over its
+    /// locked-border sequence) and write it as a version-4 .mts file, which
+    /// `info` and `verify` read. The strip and band options apply to every
+    /// group.
+    #[arg(long, conflicts_with_all = ["optimal", "recipe_only"])]
+    pub hierarchy: bool,
 }
 
 impl BuildArgs {
@@ -82,6 +90,9 @@ pub fn run(args: &BuildArgs) -> Result<()> {
     let load = started.elapsed();
     note_gltf_parts(&args.source)?;
     let options = args.pipeline_options();
+    if args.hierarchy {
+        return run_hierarchy(args, &name, &mesh, options, load);
+    }
     if args.optimal && !mesh.properties.is_empty() {
         bail!(
             "{name}: the MTS model cannot hold the vertices optimal placement creates with \
@@ -161,6 +172,94 @@ pub fn run(args: &BuildArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `build --hierarchy`: the hierarchy of `mesh`, written as a version-4
+/// file, and its sizes.
+fn run_hierarchy(
+    args: &BuildArgs,
+    name: &str,
+    mesh: &Mesh,
+    pipeline: mts::model::PipelineOptions,
+    load: std::time::Duration,
+) -> Result<()> {
+    let options = mts::hierarchy::HierarchyOptions {
+        pipeline,
+        ..Default::default()
+    };
+    let started = std::time::Instant::now();
+    let h = hierarchy_with_spinner(mesh, &options)?;
+    let build = started.elapsed();
+    let bytes = h.to_bytes();
+    mts::output::write_file(&args.output, &bytes)?;
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let raw = h.raw_bytes();
+    if args.json {
+        outln!(
+            "{}",
+            json!({
+                "input": name,
+                "vertices": h.vertex_count(),
+                "triangles": h.triangle_count(),
+                "levels": h.level_count(),
+                "groups": h.groups().len(),
+                "clusters": h.clusters().len(),
+                "memory_bytes": h.memory_bytes(),
+                "bytes": bytes.len(),
+                "raw_bytes": raw,
+                "ms_load": ms(load),
+                "build_ms": ms(build),
+            })
+        )?;
+    } else {
+        outln!(
+            "{name}: {} triangles, {} vertices: a hierarchy of {} groups over {} levels, {} clusters",
+            h.triangle_count(),
+            h.vertex_count(),
+            h.groups().len(),
+            h.level_count(),
+            h.clusters().len()
+        )?;
+        outln!(
+            "  time      load {:.1} ms, build {:.1} ms",
+            ms(load),
+            ms(build)
+        )?;
+        outln!(
+            "  memory    {:.1} MB = {:.2} x raw",
+            h.memory_bytes() as f64 / 1e6,
+            h.memory_bytes() as f64 / raw as f64
+        )?;
+        outln!(
+            "  file      {} bytes = {:.2} x raw ({raw} bytes: 12 per vertex and its properties, 12 per triangle) -> {}",
+            bytes.len(),
+            bytes.len() as f64 / raw as f64,
+            args.output.display()
+        )?;
+    }
+    Ok(())
+}
+
+/// [`mts::hierarchy::build`] with a spinner on large inputs (the core
+/// reports no progress from inside it).
+fn hierarchy_with_spinner(
+    mesh: &Mesh,
+    options: &mts::hierarchy::HierarchyOptions,
+) -> mts::Result<mts::hierarchy::Hierarchy> {
+    use indicatif::{ProgressBar, ProgressStyle};
+    let bar = if mesh.triangle_count() >= PROGRESS_MIN_TRIANGLES {
+        ProgressBar::new_spinner()
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar.set_message("hierarchy (groups on every core)");
+    let out = mts::hierarchy::build(mesh, options);
+    bar.finish_and_clear();
+    out
 }
 
 /// Inputs of this many triangles or more get a progress bar.

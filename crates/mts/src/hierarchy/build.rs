@@ -43,6 +43,9 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
         clusters: Vec::new(),
         cluster_triangles: Vec::new(),
         groups: Vec::new(),
+        positions: mesh.positions.clone(),
+        properties: mesh.properties.clone(),
+        cluster_strips: Vec::new(),
         vertex_count: mesh.vertex_count(),
         triangle_count: mesh.triangle_count(),
     };
@@ -140,6 +143,7 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
         current = next;
         level += 1;
     }
+    super::strips::strip_clusters(&mut h, &options.pipeline.stripify);
     #[cfg(debug_assertions)]
     if let Err(e) = h.validate() {
         panic!("hierarchy::build made an invalid hierarchy: {e}");
@@ -157,6 +161,7 @@ impl Hierarchy {
             triangles: start..self.cluster_triangles.len() as u32,
             producer,
             consumer: NO_GROUP,
+            strip: 0..0,
         });
         (self.clusters.len() - 1) as u32
     }
@@ -253,9 +258,14 @@ fn build_group(
         triangles: local,
         properties,
     };
+    let loose = loose_border_points(&submesh);
     let locked: Vec<bool> = vertices
         .iter()
-        .map(|&v| shared[mesh.properties.position_id(v) as usize])
+        .zip(0u32..)
+        .map(|(&v, i)| {
+            shared[mesh.properties.position_id(v) as usize]
+                || loose[submesh.properties.position_id(i) as usize]
+        })
         .collect();
     let mut simplify_options = options.pipeline.simplify;
     simplify_options.stop_at_triangles = Some(submesh.triangle_count() / 2);
@@ -281,5 +291,147 @@ fn build_group(
         output,
         centre,
         radius,
+    }
+}
+
+/// The points of `mesh` (by position id) that [`build_group`] locks besides
+/// its outer border: every point on the *boundary* (some edge at it is held
+/// by more triangles in one direction than in the other, the boundary that
+/// `select.rs` keeps and `tests/hierarchy.rs` checks) whose fan is not a
+/// single consistently oriented half-disc (exactly two edges of one
+/// triangle, every other edge two triangles of opposite directions, in one
+/// piece). Also every corner of a triangle with a repeated point.
+///
+/// Why: contracting `u` into `v` puts `v` in place of `u` in every triangle,
+/// so `u`'s boundary edges become `v`'s. That is harmless when `v` is a
+/// boundary point of the input too, and the simplifier sees to it only for
+/// the borders it knows: a vertex on an edge of one triangle (or of four or
+/// more) leaves only along such an edge. A half-disc's boundary edges are
+/// edges of one triangle, so it slides along its border, and a point off
+/// the boundary moves no boundary edge wherever it goes (a fold of a closed
+/// part included): neither is locked, so a manifold input's hierarchy is
+/// unchanged. But an edge of two triangles of the same direction (a flipped
+/// triangle beside its neighbours, a doubled one on its sheet), or of
+/// three, is a boundary edge that the simplifier counts as interior: a
+/// vertex whose boundary is made of such edges goes anywhere, onto an
+/// interior point, and that point is left with edges no triangle reverses,
+/// a crack against the neighbouring group (which keeps the shared point).
+/// The property test `random_surfaces_are_cut_without_cracks` found it; in
+/// its smallest form (`a_flipped_triangle_is_cut_without_cracks`), one
+/// flipped triangle in a hilly 4 × 4 grid: each of its corners has two
+/// edges held twice in one direction, and level 0 contracted one corner
+/// onto a locked interior point, leaving two open edges there. A fan in
+/// several pieces (a bowtie, or a half-disc beside a closed pocket) is
+/// locked as well: once the pocket collapsed, the simplifier moved such a
+/// vertex along its stale pair onto the pocket's interior point.
+///
+/// This judges the group's input. A fan can change kind during the sequence
+/// (a merge up to the input's most crowded edge can make a fin at a
+/// half-disc); no group of 61,000 random surfaces (holes, flipped, doubled
+/// and opposed triangles, fins) moved the boundary that way
+/// (`docs/experiments/hierarchy.md`).
+///
+/// Cost: O(corners log corners).
+fn loose_border_points(mesh: &Mesh) -> Vec<bool> {
+    let point = |v: u32| mesh.properties.position_id(v);
+    let points = (0..mesh.vertex_count() as u32)
+        .map(|v| point(v) as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut loose = vec![false; points];
+    // Corners by point: (point, the point after it, the point before it).
+    let mut corners: Vec<(u32, u32, u32)> = Vec::with_capacity(3 * mesh.triangle_count());
+    for t in &mesh.triangles {
+        let p = t.map(point);
+        if p[0] == p[1] || p[1] == p[2] || p[2] == p[0] {
+            for q in p {
+                loose[q as usize] = true;
+            }
+            continue;
+        }
+        for k in 0..3 {
+            corners.push((p[k], p[(k + 1) % 3], p[(k + 2) % 3]));
+        }
+    }
+    corners.sort_unstable();
+    let (mut around, mut counts, mut parent) = (Vec::new(), Vec::new(), Vec::new());
+    for fan in corners.chunk_by(|x, y| x.0 == y.0) {
+        // The link: an edge (after, before) per triangle over the
+        // neighbours; a half-disc's is one path, each neighbour at most once
+        // after the point and once before it.
+        around.clear();
+        around.extend(fan.iter().flat_map(|&(_, a, b)| [a, b]));
+        around.sort_unstable();
+        around.dedup();
+        counts.clear();
+        counts.resize(around.len(), (0u32, 0u32));
+        parent.clear();
+        parent.extend(0..around.len());
+        let index = |w: u32| around.binary_search(&w).unwrap_or(0);
+        for &(_, a, b) in fan {
+            let (i, j) = (index(a), index(b));
+            counts[i].0 += 1;
+            counts[j].1 += 1;
+            let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
+            parent[ri] = rj;
+        }
+        let on_boundary = counts.iter().any(|&(after, before)| after != before);
+        let once = counts
+            .iter()
+            .all(|&(after, before)| after <= 1 && before <= 1);
+        let pieces = (0..around.len())
+            .filter(|&i| root(&mut parent, i) == i)
+            .count();
+        if on_boundary && !(once && pieces == 1) {
+            loose[fan[0].0 as usize] = true;
+        }
+    }
+    loose
+}
+
+/// The root of `i` in the union-find forest `parent`, halving the path.
+fn root(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn loose(triangles: Vec<[u32; 3]>) -> Vec<u32> {
+        let n = triangles.iter().flatten().max().map_or(0, |&m| m + 1);
+        let mesh = Mesh {
+            positions: vec![Vec3::ZERO; n as usize],
+            triangles,
+            properties: Properties::default(),
+        };
+        let flags = loose_border_points(&mesh);
+        (0..n).filter(|&p| flags[p as usize]).collect()
+    }
+
+    #[test]
+    fn only_boundary_points_without_a_half_disc_are_loose() {
+        // A 2 × 2 grid: discs and half-discs.
+        let grid = crate::mesh::generate::grid(2, 2).triangles;
+        assert_eq!(loose(grid.clone()), Vec::<u32>::new());
+        // One triangle flipped: its corners have edges held twice in one
+        // direction; the other points are as they were.
+        let mut flipped = grid;
+        let t = flipped.iter().position(|t| t.contains(&4)).unwrap();
+        let [a, b, c] = flipped[t];
+        flipped[t] = [a, c, b];
+        let mut corners = vec![a, b, c];
+        corners.sort_unstable();
+        assert_eq!(loose(flipped), corners);
+        // A closed pocket (two opposed triangles) has no boundary; beside a
+        // triangle its shared point's fan is in two pieces.
+        assert_eq!(loose(vec![[0, 1, 2], [0, 2, 1]]), Vec::<u32>::new());
+        assert_eq!(loose(vec![[0, 1, 2], [0, 2, 1], [0, 3, 4]]), [0]);
+        // A fin: three triangles on edge (0, 1).
+        assert_eq!(loose(vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]]), [0, 1]);
     }
 }

@@ -14,7 +14,9 @@
 //! - **Build** (`build.rs`): each group's input becomes a submesh (input
 //!   vertices and properties, seams kept) simplified toward half with its
 //!   *outer border* locked ([`crate::simplify::simplify_locked`]): every
-//!   point that a triangle of another group of the same level also uses.
+//!   point that a triangle of another group of the same level also uses;
+//!   and every boundary point whose fan is not a consistently oriented
+//!   half-disc (a non-manifold input's: `build.rs`, `loose_border_points`).
 //!   The sequence, stopped there, and the submesh's strips make the group's
 //!   [`MtsModel`]; its last LoD, its *output*, is cut into the next level's
 //!   clusters. Levels repeat until one group is left or a level keeps more
@@ -28,12 +30,18 @@
 //!   rule and why what it draws has no crack.
 
 mod build;
+mod cracks;
+pub mod format;
 mod grouping;
 mod partition;
+mod runtime;
 mod select;
+mod strips;
 
 pub use build::build;
-pub use select::{select, Cut};
+pub use cracks::cracks;
+pub use runtime::{FrameUpdate, Frustum, View, ViewDependent};
+pub use select::{select, select_exhaustive, select_into, Cut, Selection};
 
 use crate::error::ensure;
 use crate::model::MtsModel;
@@ -85,6 +93,9 @@ pub struct Cluster {
     pub producer: u32,
     /// The group whose input it is; [`NO_GROUP`] for a root's output.
     pub consumer: u32,
+    /// Its strips: a range of the hierarchy's flat strip array (read them
+    /// with [`Hierarchy::cluster_strip`]).
+    pub strip: std::ops::Range<u32>,
 }
 
 /// A group of adjacent clusters of one level, simplified with its outer
@@ -157,6 +168,12 @@ pub struct Hierarchy {
     pub(crate) clusters: Vec<Cluster>,
     pub(crate) cluster_triangles: Vec<[u32; 3]>,
     pub(crate) groups: Vec<Group>,
+    /// The input's vertices: what every cut indexes (one vertex buffer).
+    pub(crate) positions: Vec<Vec3>,
+    pub(crate) properties: crate::mesh::Properties,
+    /// Every cluster's strips, runs separated by [`crate::strip::encode::RESTART_U32`],
+    /// in input vertex numbers.
+    pub(crate) cluster_strips: Vec<u32>,
     pub(crate) vertex_count: usize,
     pub(crate) triangle_count: usize,
 }
@@ -179,6 +196,28 @@ impl Hierarchy {
     pub fn cluster_triangles(&self, c: usize) -> &[[u32; 3]] {
         let r = &self.clusters[c].triangles;
         &self.cluster_triangles[r.start as usize..r.end as usize]
+    }
+
+    /// The strips of cluster `c`: runs in input vertex numbers separated by
+    /// [`crate::strip::encode::RESTART_U32`], drawing exactly
+    /// [`Hierarchy::cluster_triangles`].
+    #[must_use]
+    pub fn cluster_strip(&self, c: usize) -> &[u32] {
+        let r = &self.clusters[c].strip;
+        &self.cluster_strips[r.start as usize..r.end as usize]
+    }
+
+    /// The input's vertex positions, which every cut indexes.
+    #[must_use]
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// The input's vertex properties (normals, UVs, colours, texture,
+    /// position ids), for [`Hierarchy::positions`].
+    #[must_use]
+    pub fn properties(&self) -> &crate::mesh::Properties {
+        &self.properties
     }
 
     /// Levels of groups (the highest level plus one; 0 for an empty mesh).
@@ -214,7 +253,10 @@ impl Hierarchy {
             .sum();
         groups
             + 12 * self.cluster_triangles.len()
+            + 4 * self.cluster_strips.len()
             + std::mem::size_of::<Cluster>() * self.clusters.len()
+            + (12 + self.properties.bytes_per_vertex()) * self.positions.len()
+            + 4 * self.properties.position_ids.len()
     }
 
     /// Checks the invariants listed on [`Hierarchy`].
@@ -224,10 +266,35 @@ impl Hierarchy {
     pub fn validate(&self) -> std::result::Result<(), crate::Invalid> {
         const S: &str = "Hierarchy";
         let (nc, ng) = (self.clusters.len(), self.groups.len() as u32);
+        let nv = self.positions.len();
+        ensure!(
+            S,
+            nv == self.vertex_count,
+            "{nv} positions for {} vertices",
+            self.vertex_count
+        );
         for (i, c) in self.clusters.iter().enumerate() {
             let ok = c.triangles.start <= c.triangles.end
                 && c.triangles.end as usize <= self.cluster_triangles.len();
             ensure!(S, ok, "cluster {i}: triangles out of range");
+            let ok =
+                c.strip.start <= c.strip.end && c.strip.end as usize <= self.cluster_strips.len();
+            ensure!(S, ok, "cluster {i}: strips out of range");
+            let triangles = self.cluster_triangles(i);
+            let in_range = triangles.iter().flatten().all(|&v| (v as usize) < nv);
+            ensure!(S, in_range, "cluster {i}: a vertex out of range");
+            let strip = self.cluster_strip(i);
+            let in_range = strip
+                .iter()
+                .all(|&v| v == crate::strip::encode::RESTART_U32 || (v as usize) < nv);
+            ensure!(S, in_range, "cluster {i}: a strip vertex out of range");
+            let drawn = crate::strip::sorted_canonical(&strips::triangles_of(strip));
+            let own = crate::strip::sorted_canonical(triangles);
+            ensure!(
+                S,
+                drawn == own,
+                "cluster {i}: its strips do not draw its triangles"
+            );
             for (end, name) in [(c.producer, "producer"), (c.consumer, "consumer")] {
                 ensure!(
                     S,

@@ -52,6 +52,11 @@
 //!
 //! Every count is checked against the bytes that must hold it before
 //! anything is allocated, so a corrupt file costs at most its own size.
+//!
+//! Version 4 holds a view-dependent hierarchy instead of a model, each of
+//! its groups' models in the sections above ([`crate::hierarchy::format`]):
+//! [`MtsModel::from_bytes`] says so when given one, and [`holds`] tells
+//! the two kinds apart from the header.
 
 use super::records::Narrow;
 use super::{build, BuildOptions, MtsModel};
@@ -73,12 +78,87 @@ const TAGS: [&[u8; 4]; 7] = [
 /// Sections of a version-1 file.
 const V1_SECTIONS: usize = 4;
 
+/// The sections a hierarchy's group leaves out: its vertices are the
+/// input's (`hierarchy/format.rs`).
+const VERTEX_TAGS: [&[u8; 4]; 2] = [b"POSI", b"PROP"];
+
 /// Sections of a file of `version`.
 fn section_count(version: u32) -> usize {
     match version {
         1 => V1_SECTIONS,
         2 => 6,
         _ => TAGS.len(),
+    }
+}
+
+/// What an `.mts` file holds, by its version: a per-object model
+/// (versions 1 to 3) or a view-dependent hierarchy (version 4,
+/// [`crate::hierarchy::Hierarchy`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Holds {
+    /// An [`MtsModel`] (versions 1 to [`VERSION`]).
+    Model,
+    /// A [`crate::hierarchy::Hierarchy`] (version
+    /// [`crate::hierarchy::format::VERSION`]).
+    Hierarchy,
+}
+
+/// The version in the header of `.mts` bytes, or `None` when they do not
+/// start with [`MAGIC`] and a version: what a reader of both kinds peeks at
+/// before it chooses [`MtsModel::from_bytes`] or
+/// [`crate::hierarchy::Hierarchy::from_bytes`] (see [`holds`]).
+#[must_use]
+pub fn file_version(bytes: &[u8]) -> Option<u32> {
+    if bytes.len() < 12 || &bytes[..8] != MAGIC {
+        return None;
+    }
+    Some(u32::from_le_bytes([
+        bytes[8], bytes[9], bytes[10], bytes[11],
+    ]))
+}
+
+/// What `.mts` bytes hold, from their header's version; `None` when they
+/// are not an `.mts` file of a known version (the loaders then say why).
+#[must_use]
+pub fn holds(bytes: &[u8]) -> Option<Holds> {
+    match file_version(bytes)? {
+        1..=VERSION => Some(Holds::Model),
+        crate::hierarchy::format::VERSION => Some(Holds::Hierarchy),
+        _ => None,
+    }
+}
+
+/// Appends each section: tag, payload length (`u64`), payload.
+pub(crate) fn put_sections<'t>(
+    out: &mut Vec<u8>,
+    sections: impl IntoIterator<Item = (&'t [u8; 4], Vec<u8>)>,
+) {
+    for (tag, payload) in sections {
+        out.extend_from_slice(tag);
+        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+        out.extend_from_slice(&payload);
+    }
+}
+
+/// The file: the header (magic, `version`, `sections`, length, checksum of
+/// `body`: FNV-1a before version 3, its word form since) and `body`.
+pub(crate) fn seal_body(version: u32, sections: usize, body: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(HEADER_LEN + body.len());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&version.to_le_bytes());
+    out.extend_from_slice(&(sections as u32).to_le_bytes());
+    out.extend_from_slice(&((HEADER_LEN + body.len()) as u64).to_le_bytes());
+    out.extend_from_slice(&body_checksum(version, body).to_le_bytes());
+    out.extend_from_slice(body);
+    out
+}
+
+/// The checksum of a body of a file of `version`.
+fn body_checksum(version: u32, body: &[u8]) -> u64 {
+    if version < 3 {
+        crate::checksum::fnv1a64(body)
+    } else {
+        crate::checksum::fnv1a64_words(body)
     }
 }
 
@@ -100,6 +180,23 @@ impl MtsModel {
     }
 
     fn encode(&self, ready: bool) -> Vec<u8> {
+        let version = if ready {
+            VERSION
+        } else if self.properties.is_empty() && !self.recipe.collapses.has_companions() {
+            1
+        } else {
+            2
+        };
+        let payloads = self.payloads(version);
+        let mut body = Vec::new();
+        let sections = payloads.len();
+        put_sections(&mut body, TAGS.iter().copied().zip(payloads));
+        seal_body(version, sections, &body)
+    }
+
+    /// The payloads of the sections of a version-`version` file, in the
+    /// order of [`TAGS`].
+    fn payloads(&self, version: u32) -> Vec<Vec<u8>> {
         let r = &self.recipe;
         let c = &r.collapses;
         let mut meta = Vec::new();
@@ -147,13 +244,6 @@ impl MtsModel {
         }
 
         let mut payloads = vec![meta, posi, strp, step];
-        let version = if ready {
-            VERSION
-        } else if self.properties.is_empty() && !c.has_companions() {
-            1
-        } else {
-            2
-        };
         if version > 1 {
             payloads.push(properties_payload(&self.properties));
             let mut cmpn = Vec::new();
@@ -170,26 +260,18 @@ impl MtsModel {
         if version > 2 {
             payloads.push(self.model_payload());
         }
-        let mut body = Vec::new();
-        let sections = payloads.len();
-        for (tag, payload) in TAGS.iter().zip(payloads) {
-            body.extend_from_slice(*tag);
-            body.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-            body.extend_from_slice(&payload);
-        }
-        let mut out = Vec::with_capacity(HEADER_LEN + body.len());
-        out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&version.to_le_bytes());
-        out.extend_from_slice(&(sections as u32).to_le_bytes());
-        out.extend_from_slice(&((HEADER_LEN + body.len()) as u64).to_le_bytes());
-        let sum = if ready {
-            crate::checksum::fnv1a64_words(&body)
-        } else {
-            crate::checksum::fnv1a64(&body)
-        };
-        out.extend_from_slice(&sum.to_le_bytes());
-        out.extend_from_slice(&body);
-        out
+        payloads
+    }
+
+    /// The model's sections as a version-3 file has them, without `POSI`
+    /// and `PROP` unless `own_vertices` (a hierarchy's group, whose
+    /// vertices are the input's, gathered: `hierarchy/format.rs`).
+    pub(crate) fn sections(&self, own_vertices: bool) -> Vec<(&'static [u8; 4], Vec<u8>)> {
+        TAGS.iter()
+            .copied()
+            .zip(self.payloads(VERSION))
+            .filter(|(tag, _)| own_vertices || !VERTEX_TAGS.contains(tag))
+            .collect()
     }
 
     /// The `MODL` section.
@@ -265,32 +347,42 @@ impl MtsModel {
     /// naming the byte offset and section of the first problem otherwise
     /// (truncation, checksum, counts, indices, labels).
     pub fn from_bytes(bytes: &[u8], file: &Path) -> Result<MtsModel> {
-        let mut parsed = parse(bytes, file)?;
-        let Some(arrays) = parsed.arrays.take() else {
-            let model = build(
-                &parsed.mesh,
-                &parsed.strips,
-                &parsed.collapses,
-                &parsed.options,
-            );
-            debug_assert_eq!(model.properties, parsed.mesh.properties);
-            model.validate().map_err(|e| {
-                parse_error(
-                    file,
-                    0,
-                    "model",
-                    format!("built model is invalid: {}", e.message),
-                )
-            })?;
-            return Ok(model);
-        };
-        let at = parsed.modl.as_ref().map_or(0, |m| m.base);
-        let model = assemble(arrays?, parsed);
-        model
-            .validate_against_recipe()
-            .map_err(|e| parse_error(file, at, "MODL", e.message))?;
-        Ok(model)
+        let sections = model_sections(bytes, file)?;
+        read_model(sections, file, true)
     }
+}
+
+/// Decodes one model's sections and checks it: a recipe (no `MODL`) is
+/// built and validated, a ready model checked against its recipe
+/// ([`MtsModel::validate_against_recipe`]). With `threaded`, the `MODL`
+/// arrays are read on a second thread while the recipe is parsed.
+pub(crate) fn read_model(s: ModelSections<'_>, file: &Path, threaded: bool) -> Result<MtsModel> {
+    let mut parsed = parse_model(s, threaded)?;
+    let Some(arrays) = parsed.arrays.take() else {
+        let model = build(
+            &parsed.mesh,
+            &parsed.strips,
+            &parsed.collapses,
+            &parsed.options,
+        );
+        debug_assert_eq!(model.properties, parsed.mesh.properties);
+        model.validate().map_err(|e| {
+            parse_error(
+                file,
+                0,
+                "model",
+                format!("built model is invalid: {}", e.message),
+            )
+        })?;
+        return Ok(model);
+    };
+    let at = parsed.modl.as_ref().map_or(0, |m| m.base);
+    let section = parsed.modl.as_ref().map_or("MODL", |m| m.section);
+    let model = assemble(arrays?, parsed);
+    model
+        .validate_against_recipe()
+        .map_err(|e| parse_error(file, at, section, e.message))?;
+    Ok(model)
 }
 
 /// Rewrites the header's file length and checksum to match `bytes` (for
@@ -304,12 +396,7 @@ pub fn seal(bytes: &mut [u8]) {
     let len = bytes.len() as u64;
     bytes[16..24].copy_from_slice(&len.to_le_bytes());
     let version = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
-    let body = &bytes[HEADER_LEN..];
-    let sum = if version < 3 {
-        crate::checksum::fnv1a64(body)
-    } else {
-        crate::checksum::fnv1a64_words(body)
-    };
+    let sum = body_checksum(version, &bytes[HEADER_LEN..]);
     bytes[24..32].copy_from_slice(&sum.to_le_bytes());
 }
 
@@ -343,19 +430,37 @@ fn parse_error(file: &Path, byte: usize, element: &str, message: String) -> Erro
 
 /// A bounds-checked little-endian reader over one section.
 #[derive(Clone)]
-struct Reader<'a> {
-    bytes: &'a [u8],
-    pos: usize,
+pub(crate) struct Reader<'a> {
+    pub(crate) bytes: &'a [u8],
+    pub(crate) pos: usize,
     /// Offset of `bytes` in the file, for error places.
-    base: usize,
-    section: &'static str,
-    file: PathBuf,
+    pub(crate) base: usize,
+    pub(crate) section: &'static str,
+    pub(crate) file: PathBuf,
 }
 
-impl Reader<'_> {
+impl<'a> Reader<'a> {
+    /// A reader over `bytes`, which start at byte `base` of `file`, named
+    /// `section` in errors.
+    pub(crate) fn new(
+        bytes: &'a [u8],
+        base: usize,
+        section: &'static str,
+        file: &Path,
+    ) -> Reader<'a> {
+        Reader {
+            bytes,
+            pos: 0,
+            base,
+            section,
+            file: file.to_owned(),
+        }
+    }
+
+    /// An error at the current position.
     #[cold]
     #[inline(never)]
-    fn error(&self, message: impl Into<String>) -> Error {
+    pub(crate) fn error(&self, message: impl Into<String>) -> Error {
         parse_error(
             &self.file,
             self.base + self.pos,
@@ -364,12 +469,12 @@ impl Reader<'_> {
         )
     }
 
-    fn remaining(&self) -> usize {
+    pub(crate) fn remaining(&self) -> usize {
         self.bytes.len() - self.pos
     }
 
     #[inline]
-    fn take(&mut self, n: usize) -> Result<&[u8]> {
+    pub(crate) fn take(&mut self, n: usize) -> Result<&[u8]> {
         if self.remaining() < n {
             return Err(self.error(format!(
                 "truncated: {n} bytes needed, {} left",
@@ -382,24 +487,24 @@ impl Reader<'_> {
     }
 
     #[inline]
-    fn u8(&mut self) -> Result<u8> {
+    pub(crate) fn u8(&mut self) -> Result<u8> {
         Ok(self.take(1)?[0])
     }
 
     #[inline]
-    fn f32(&mut self) -> Result<f32> {
+    pub(crate) fn f32(&mut self) -> Result<f32> {
         let b = self.take(4)?;
         Ok(f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
 
-    fn f64(&mut self) -> Result<f64> {
+    pub(crate) fn f64(&mut self) -> Result<f64> {
         let mut a = [0u8; 8];
         a.copy_from_slice(self.take(8)?);
         Ok(f64::from_le_bytes(a))
     }
 
     /// `n` little-endian `u32`s.
-    fn words(&mut self, n: usize) -> Result<Vec<u32>> {
+    pub(crate) fn words(&mut self, n: usize) -> Result<Vec<u32>> {
         let bytes = self.take(
             n.checked_mul(4)
                 .ok_or_else(|| self.error("count overflows"))?,
@@ -411,7 +516,7 @@ impl Reader<'_> {
     }
 
     #[inline]
-    fn varint(&mut self) -> Result<u64> {
+    pub(crate) fn varint(&mut self) -> Result<u64> {
         // Fast path: a one- or two-byte varint with its bytes present.
         if let [b0, rest @ ..] = &self.bytes[self.pos..] {
             if b0 & 0x80 == 0 {
@@ -440,7 +545,7 @@ impl Reader<'_> {
     }
 
     /// A varint that must be at most `max`, named `what` in errors.
-    fn count(&mut self, what: &str, max: u64) -> Result<usize> {
+    pub(crate) fn count(&mut self, what: &str, max: u64) -> Result<usize> {
         let at = self.pos;
         let v = self.varint()?;
         if v > max {
@@ -450,7 +555,7 @@ impl Reader<'_> {
         Ok(v as usize)
     }
 
-    fn finish(&self) -> Result<()> {
+    pub(crate) fn finish(&self) -> Result<()> {
         if self.remaining() != 0 {
             return Err(self.error(format!(
                 "{} unexpected bytes at the end of the section",
@@ -461,7 +566,16 @@ impl Reader<'_> {
     }
 }
 
-fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
+/// Checks the header of `.mts` `bytes` that should hold `holds`: the
+/// magic, a version of that kind (a file of the other kind is named as
+/// such), the section count (`sections(version)`), the file length and
+/// the checksum. Returns the version and a reader over the body.
+pub(crate) fn check_header<'a>(
+    bytes: &'a [u8],
+    file: &Path,
+    holds: Holds,
+    sections: impl Fn(u32) -> usize,
+) -> Result<(u32, Reader<'a>)> {
     if bytes.len() < HEADER_LEN || &bytes[..8] != MAGIC {
         return Err(Error::UnknownFormat {
             file: file.to_owned(),
@@ -484,16 +598,33 @@ fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
         u64::from_le_bytes(a)
     };
     let version = u32_at(8);
-    if !(1..=VERSION).contains(&version) {
+    let hierarchy = crate::hierarchy::format::VERSION;
+    let wrong = match (holds, version) {
+        (Holds::Model, 1..=VERSION) => None,
+        (Holds::Hierarchy, v) if v == hierarchy => None,
+        (Holds::Model, v) if v == hierarchy => Some(format!(
+            "byte 8: .mts version {v} holds a view-dependent hierarchy (`mts build \
+             --hierarchy`), not a per-object model: `mts info` and `mts verify` read it (in \
+             the library: mts::hierarchy::Hierarchy::load)"
+        )),
+        (Holds::Hierarchy, v @ 1..=VERSION) => Some(format!(
+            "byte 8: .mts version {v} holds a per-object model, not a view-dependent \
+             hierarchy (version {hierarchy}): `mts build --hierarchy` writes one (in the \
+             library: mts::MtsModel::load reads this file)"
+        )),
+        (_, v) => Some(format!(
+            "byte 8: .mts version {v}; this build reads versions 1 to {VERSION} (a model) \
+             and {hierarchy} (a hierarchy)"
+        )),
+    };
+    if let Some(message) = wrong {
         return Err(Error::UnknownFormat {
             file: file.to_owned(),
-            message: format!(
-                "byte 8: .mts version {version}; this build reads versions 1 to {VERSION}"
-            ),
+            message,
         });
     }
     let header = |byte, m: String| parse_error(file, byte, "header", m);
-    let section_count = section_count(version);
+    let section_count = sections(version);
     if u32_at(12) as usize != section_count {
         return Err(header(
             12,
@@ -514,27 +645,28 @@ fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
         ));
     }
     let body = &bytes[HEADER_LEN..];
-    let sum = if version < 3 {
-        crate::checksum::fnv1a64(body)
-    } else {
-        crate::checksum::fnv1a64_words(body)
-    };
+    let sum = body_checksum(version, body);
     if u64_at(24) != sum {
         return Err(header(
             24,
             format!("checksum {:#018x}, content gives {sum:#018x}", u64_at(24)),
         ));
     }
-    // Split into sections.
-    let mut sections = Vec::with_capacity(section_count);
-    let mut top = Reader {
-        bytes: body,
-        pos: 0,
-        base: HEADER_LEN,
-        section: "section table",
-        file: file.to_owned(),
-    };
-    for (i, tag) in TAGS.iter().take(section_count).enumerate() {
+    Ok((
+        version,
+        Reader::new(body, HEADER_LEN, "section table", file),
+    ))
+}
+
+/// Reads from `top` one section per tag of `tags`, in that order (tag,
+/// `u64` length, payload), each checked against the bytes left: a reader
+/// over each payload, named by its tag.
+pub(crate) fn split_sections<'a>(
+    top: &mut Reader<'a>,
+    tags: &[&'static [u8; 4]],
+) -> Result<Vec<Reader<'a>>> {
+    let mut sections = Vec::with_capacity(tags.len().min(top.remaining() / 12));
+    for (i, &tag) in tags.iter().enumerate() {
         let at = top.pos;
         let got = top.take(4)?.to_vec();
         if got != *tag {
@@ -542,7 +674,7 @@ fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
             return Err(top.error(format!(
                 "section {i} is {:?}, expected {:?}",
                 String::from_utf8_lossy(&got),
-                String::from_utf8_lossy(*tag)
+                String::from_utf8_lossy(tag)
             )));
         }
         let mut len = [0u8; 8];
@@ -555,35 +687,103 @@ fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
             )));
         }
         let start = top.pos;
-        top.take(len as usize)?;
-        sections.push(Reader {
-            bytes: &body[start..start + len as usize],
-            pos: 0,
-            base: HEADER_LEN + start,
-            section: SECTION_NAMES[i],
-            file: file.to_owned(),
-        });
+        let bytes: &'a [u8] = &top.bytes[start..start + len as usize];
+        top.pos += len as usize;
+        let name = std::str::from_utf8(&tag[..]).unwrap_or("section");
+        sections.push(Reader::new(bytes, top.base + start, name, &top.file));
     }
+    Ok(sections)
+}
+
+/// One model's sections: `META`, `STRP`, `STEP`; `CMPN` from version 2 on
+/// and `MODL` from version 3 on; its vertices from `POSI` and (from version
+/// 2 on) `PROP`, or given (a hierarchy's group).
+pub(crate) struct ModelSections<'a> {
+    pub(crate) meta: Reader<'a>,
+    pub(crate) vertices: Vertices<'a>,
+    pub(crate) strp: Reader<'a>,
+    pub(crate) step: Reader<'a>,
+    pub(crate) cmpn: Option<Reader<'a>>,
+    pub(crate) modl: Option<Reader<'a>>,
+}
+
+/// Where a model's vertices come from.
+pub(crate) enum Vertices<'a> {
+    /// Its own `POSI` section (input vertices, then appended ones) and
+    /// `PROP` section (none in version 1).
+    Stored {
+        posi: Reader<'a>,
+        prop: Option<Reader<'a>>,
+    },
+    /// Given whole (no appended vertex): a hierarchy group's, gathered from
+    /// the input's.
+    Given {
+        positions: Vec<Vec3>,
+        properties: crate::mesh::Properties,
+    },
+}
+
+/// The sections of a model file (versions 1 to 3), its header checked.
+fn model_sections<'a>(bytes: &'a [u8], file: &Path) -> Result<ModelSections<'a>> {
+    let (version, mut top) = check_header(bytes, file, Holds::Model, section_count)?;
+    let mut sections = split_sections(&mut top, &TAGS[..section_count(version)])?;
     top.finish()?;
     let mut extra = sections.split_off(V1_SECTIONS).into_iter();
     let (prop, cmpn, modl) = (extra.next(), extra.next(), extra.next());
-    let [mut meta, mut posi, mut strp, mut step]: [Reader; 4] = sections
+    let [meta, posi, strp, step]: [Reader; 4] = sections
         .try_into()
         .map_err(|_| parse_error(file, HEADER_LEN, "section table", "section count".into()))?;
+    Ok(ModelSections {
+        meta,
+        vertices: Vertices::Stored { posi, prop },
+        strp,
+        step,
+        cmpn,
+        modl,
+    })
+}
 
+/// Decodes and checks one model's sections (every count bounded by the
+/// bytes of the section that holds it, every index by its range).
+fn parse_model(s: ModelSections<'_>, threaded: bool) -> Result<Parsed<'_>> {
+    let ModelSections {
+        mut meta,
+        vertices: source,
+        mut strp,
+        mut step,
+        cmpn,
+        modl,
+    } = s;
     // META: counts, each bounded by the bytes of the section that holds it.
-    let vertices = meta.count("vertex count", (posi.remaining() / 12) as u64)?;
-    let appended = meta.count(
-        "appended vertex count",
-        (posi.remaining() / 12 - vertices) as u64,
-    )?;
-    if 12 * (vertices + appended) != posi.remaining() {
-        return Err(posi.error(format!(
-            "{} bytes for {} vertices",
-            posi.remaining(),
-            vertices + appended
-        )));
-    }
+    let (vertices, appended) = match &source {
+        Vertices::Stored { posi, .. } => {
+            let vertices = meta.count("vertex count", (posi.remaining() / 12) as u64)?;
+            let appended = meta.count(
+                "appended vertex count",
+                (posi.remaining() / 12 - vertices) as u64,
+            )?;
+            if 12 * (vertices + appended) != posi.remaining() {
+                return Err(posi.error(format!(
+                    "{} bytes for {} vertices",
+                    posi.remaining(),
+                    vertices + appended
+                )));
+            }
+            (vertices, appended)
+        }
+        Vertices::Given { positions, .. } => {
+            let at = meta.pos;
+            let vertices = meta.count("vertex count", positions.len() as u64)?;
+            if vertices != positions.len() {
+                meta.pos = at;
+                return Err(meta.error(format!(
+                    "{vertices} vertices, {} mapped to the input's",
+                    positions.len()
+                )));
+            }
+            (vertices, meta.count("appended vertex count", 0)?)
+        }
+    };
     let runs = meta.count("run count", (strp.remaining() / 4) as u64)?;
     let indices = meta.count("strip index count", strp.remaining() as u64)?;
     let steps = meta.count("step count", (step.remaining() / 6) as u64)?;
@@ -626,22 +826,38 @@ fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
     }
 
     // The model's arrays are read on a second thread while the recipe is
-    // parsed (version 3).
+    // parsed (version 3), when `threaded`.
     let arrays_reader = modl.clone();
     std::thread::scope(|scope| {
-        let reading = arrays_reader.map(|m| scope.spawn(move || read_arrays(m, steps)));
-        let rest = (move || -> Result<Parsed<'a>> {
-            // POSI.
-            let mut positions = Vec::with_capacity(vertices + appended);
-            for i in 0..vertices + appended {
-                let p = Vec3::new(posi.f32()?, posi.f32()?, posi.f32()?);
-                if !p.is_finite() {
-                    posi.pos -= 12;
-                    return Err(posi.error(format!("vertex {i} is not finite: {p}")));
+        let (reading, inline) = if threaded {
+            (
+                arrays_reader.map(|m| scope.spawn(move || read_arrays(m, steps))),
+                None,
+            )
+        } else {
+            (None, arrays_reader)
+        };
+        let rest = (move || -> Result<Parsed<'_>> {
+            // POSI and PROP, or the given vertices.
+            let (positions, prop, given_properties) = match source {
+                Vertices::Stored { mut posi, prop } => {
+                    let mut positions = Vec::with_capacity(vertices + appended);
+                    for i in 0..vertices + appended {
+                        let p = Vec3::new(posi.f32()?, posi.f32()?, posi.f32()?);
+                        if !p.is_finite() {
+                            posi.pos -= 12;
+                            return Err(posi.error(format!("vertex {i} is not finite: {p}")));
+                        }
+                        positions.push(p);
+                    }
+                    posi.finish()?;
+                    (positions, prop, None)
                 }
-                positions.push(p);
-            }
-            posi.finish()?;
+                Vertices::Given {
+                    positions,
+                    properties,
+                } => (positions, None, Some(properties)),
+            };
 
             // STRP.
             let mut starts = Vec::with_capacity(runs + 1);
@@ -697,6 +913,8 @@ fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
             };
             if let Some(mut prop) = prop {
                 mesh.properties = read_properties(&mut prop, &mesh.positions)?;
+            } else if let Some(properties) = given_properties {
+                mesh.properties = properties;
             }
             if strips.triangle_count() == 0 {
                 return Err(strp.error("the strips draw no triangle"));
@@ -777,13 +995,11 @@ fn parse<'a>(bytes: &'a [u8], file: &Path) -> Result<Parsed<'a>> {
         })();
         let arrays = reading.map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
         rest.map(|mut p| {
-            p.arrays = arrays;
+            p.arrays = arrays.or_else(|| inline.map(|m| read_arrays(m, steps)));
             p
         })
     })
 }
-
-const SECTION_NAMES: [&str; 7] = ["META", "POSI", "STRP", "STEP", "PROP", "CMPN", "MODL"];
 
 /// Reads the `MODL` section into the model `parsed` describes. Every count
 /// is bounded by the bytes left before anything is allocated; the
@@ -925,7 +1141,7 @@ fn table_at_end(r: &Reader<'_>, lods: usize, triangles: u32) -> Result<Vec<u32>>
 }
 
 /// The `PROP` section of `p`.
-fn properties_payload(p: &crate::mesh::Properties) -> Vec<u8> {
+pub(crate) fn properties_payload(p: &crate::mesh::Properties) -> Vec<u8> {
     use crate::mesh::Texture;
     let flags = u8::from(p.normals.is_some())
         | u8::from(p.uvs.is_some()) << 1
@@ -970,7 +1186,10 @@ fn properties_payload(p: &crate::mesh::Properties) -> Vec<u8> {
 }
 
 /// Reads and checks the `PROP` section for a mesh with `positions`.
-fn read_properties(r: &mut Reader<'_>, positions: &[Vec3]) -> Result<crate::mesh::Properties> {
+pub(crate) fn read_properties(
+    r: &mut Reader<'_>,
+    positions: &[Vec3],
+) -> Result<crate::mesh::Properties> {
     use crate::mesh::{Properties, Texture};
     use glam::{Vec2, Vec4};
     let n = positions.len();
@@ -1103,7 +1322,7 @@ fn read_companions(
     Ok(out)
 }
 
-fn flag(r: &mut Reader<'_>, what: &str) -> Result<bool> {
+pub(crate) fn flag(r: &mut Reader<'_>, what: &str) -> Result<bool> {
     match r.u8()? {
         0 => Ok(false),
         1 => Ok(true),
@@ -1170,7 +1389,7 @@ pub(crate) fn replay_counts(
     counts
 }
 
-fn put_varint(out: &mut Vec<u8>, mut v: u64) {
+pub(crate) fn put_varint(out: &mut Vec<u8>, mut v: u64) {
     while v >= 0x80 {
         out.push((v as u8) | 0x80);
         v >>= 7;
@@ -1178,11 +1397,11 @@ fn put_varint(out: &mut Vec<u8>, mut v: u64) {
     out.push(v as u8);
 }
 
-fn zigzag(v: i64) -> u64 {
+pub(crate) fn zigzag(v: i64) -> u64 {
     ((v << 1) ^ (v >> 63)) as u64
 }
 
-fn unzigzag(v: u64) -> i64 {
+pub(crate) fn unzigzag(v: u64) -> i64 {
     ((v >> 1) as i64) ^ -((v & 1) as i64)
 }
 

@@ -344,6 +344,17 @@ impl ClusterLod {
         &self.triangles[r.start as usize..r.end as usize]
     }
 
+    /// Bytes in memory: positions, every depth's triangles, the clusters
+    /// and groups (what a renderer keeps to cut the DAG; all of it is
+    /// resident, as in meshoptimizer's demo).
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        12 * self.positions.len()
+            + 12 * self.triangles.len()
+            + std::mem::size_of::<Cluster>() * self.clusters.len()
+            + std::mem::size_of::<Group>() * self.groups.len()
+    }
+
     /// Number of DAG depths (the deepest group's depth + 1); 0 when empty.
     #[must_use]
     pub fn level_count(&self) -> usize {

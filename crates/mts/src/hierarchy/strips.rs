@@ -1,0 +1,124 @@
+//! The strips of every cluster, so that a cluster drawn as it is (an input
+//! of an open group whose other inputs are refined, see `select.rs`) sends
+//! strips like the groups drawn through their models, not a triangle list.
+//!
+//! Each cluster is stripified on its own (its triangles become a small
+//! submesh; the stripifier is the pipeline's), and its runs are stored back
+//! to back in input vertex numbers, separated by [`RESTART`] (`u32::MAX`): the same
+//! marker as an [`crate::Extractor`]'s buffer, so a renderer handles both
+//! alike.
+
+use super::Hierarchy;
+use crate::mesh::Mesh;
+use crate::strip::encode::RESTART_U32 as RESTART;
+use crate::strip::{stripify, StripifyOptions};
+use glam::Vec3;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Clusters stripified per task of the worker threads.
+const CHUNK: usize = 64;
+
+/// The runs of `triangles` (input vertex numbers), each followed by
+/// [`RESTART`] but the last, appended to `out`. `remap` is all `u32::MAX`
+/// on entry and on return.
+fn strip_cluster(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    options: &StripifyOptions,
+    remap: &mut [u32],
+    out: &mut Vec<u32>,
+) {
+    let mut vertices: Vec<u32> = Vec::new();
+    let local: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                let r = &mut remap[v as usize];
+                if *r == u32::MAX {
+                    *r = vertices.len() as u32;
+                    vertices.push(v);
+                }
+                *r
+            })
+        })
+        .collect();
+    for &v in &vertices {
+        remap[v as usize] = u32::MAX;
+    }
+    let submesh = Mesh {
+        positions: vertices.iter().map(|&v| positions[v as usize]).collect(),
+        triangles: local,
+        properties: crate::mesh::Properties::default(),
+    };
+    let strips = stripify(&submesh, options);
+    for (i, run) in strips.runs().enumerate() {
+        if i > 0 {
+            out.push(RESTART);
+        }
+        out.extend(run.iter().map(|&v| vertices[v as usize]));
+    }
+}
+
+/// Fills `h.cluster_strips` and every cluster's `strip` range, on all
+/// cores.
+pub(super) fn strip_clusters(h: &mut Hierarchy, options: &StripifyOptions) {
+    let n = h.clusters.len();
+    let chunks = n.div_ceil(CHUNK);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, std::num::NonZeroUsize::get)
+        .min(chunks)
+        .max(1);
+    let next = AtomicUsize::new(0);
+    let hr: &Hierarchy = h;
+    let mut done: Vec<(usize, Vec<u32>, Vec<u32>)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut remap = vec![u32::MAX; hr.positions.len()];
+                    let mut out = Vec::new();
+                    loop {
+                        let chunk = next.fetch_add(1, Ordering::Relaxed);
+                        if chunk >= chunks {
+                            break;
+                        }
+                        let (mut indices, mut ends) = (Vec::new(), Vec::new());
+                        for c in chunk * CHUNK..((chunk + 1) * CHUNK).min(n) {
+                            let tris = hr.cluster_triangles(c);
+                            strip_cluster(&hr.positions, tris, options, &mut remap, &mut indices);
+                            ends.push(indices.len() as u32);
+                        }
+                        out.push((chunk, indices, ends));
+                    }
+                    out
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
+    done.sort_unstable_by_key(|(chunk, _, _)| *chunk);
+    let mut all = Vec::new();
+    let mut c = 0;
+    for (_, indices, ends) in done {
+        let base = all.len() as u32;
+        let mut start = base;
+        for end in ends {
+            h.clusters[c].strip = start..base + end;
+            start = base + end;
+            c += 1;
+        }
+        all.extend(indices);
+    }
+    h.cluster_strips = all;
+}
+
+/// The triangles that `strip` (runs separated by [`RESTART`]) draws.
+pub(super) fn triangles_of(strip: &[u32]) -> Vec<[u32; 3]> {
+    let mut out = Vec::new();
+    for run in strip.split(|&v| v == RESTART) {
+        crate::encoding::decode_run(run, &mut out);
+    }
+    out
+}
