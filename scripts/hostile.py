@@ -3421,11 +3421,11 @@ class V4File:
     cut into sections, its HIER counts decoded and its GRPS section cut into
     group records, each record's layout found."""
 
-    TAGS = [b"HIER", b"POSI", b"PROP", b"CLUS", b"CTRI", b"CSTR", b"GRPS"]
+    TAGS = [b"HIER", b"POSI", b"PROP", b"CLUS", b"CSTR", b"GRPS"]
 
     def __init__(self, data):
         self.version, count = struct.unpack_from("<II", data, 8)
-        if self.version != 4 or count != 7:
+        if self.version != 4 or count != 6:
             raise ValueError("not a version-4 file")
         pos = MTS_HEADER
         self.sections = []
@@ -3446,7 +3446,7 @@ class V4File:
             self.counts.append(v)
         if p != len(hier):
             raise ValueError("HIER has %d bytes, 6 varints %d" % (len(hier), p))
-        grps = self.sections[6][1]
+        grps = self.sections[5][1]
         p = 0
         self.groups = []
         while p < len(grps):
@@ -3457,7 +3457,7 @@ class V4File:
             raise ValueError("%d group records for %d groups" % (len(self.groups), self.counts[5]))
         self.len_delta = {}
         self.trailing = b""
-        self.section_count = 7
+        self.section_count = 6
 
     @staticmethod
     def layout(record):
@@ -3497,7 +3497,7 @@ class V4File:
         grps = bytearray()
         for r in self.groups:
             grps += struct.pack("<Q", len(r)) + bytes(r)
-        self.sections[6][1] = bytes(grps)
+        self.sections[5][1] = bytes(grps)
         body = bytearray()
         for i, (tag, payload) in enumerate(self.sections):
             n = max(0, len(payload) + self.len_delta.get(i, 0))
@@ -3541,12 +3541,12 @@ def hier_edit(rng, f, kind):
         f.counts[i] = rng.choice([2 ** 28, 2 ** 32 - 1, 2 ** 40, 2 ** 64 - 1])
         return "count%d" % i
     if kind == "section_len":
-        i = rng.randrange(7)
+        i = rng.randrange(6)
         f.len_delta[i] = rng.choice([-1, 1, 7, 2 ** 40, 2 ** 63])
         return "section%d" % i
     if kind == "tag":
-        i = rng.randrange(7)
-        f.sections[i][0] = rng.choice([b"XXXX", b"hier", b"MODL", b"\x00\x00\x00\x00", f.TAGS[(i + 1) % 7]])
+        i = rng.randrange(6)
+        f.sections[i][0] = rng.choice([b"XXXX", b"hier", b"MODL", b"\x00\x00\x00\x00", f.TAGS[(i + 1) % 6]])
         return "section%d" % i
     if kind == "trailing":
         f.trailing = bytes(rng.randrange(256) for _ in range(rng.randint(1, 16)))
@@ -3555,7 +3555,7 @@ def hier_edit(rng, f, kind):
         f.version = rng.choice([0, 1, 2, 3, 5, 255, 2 ** 32 - 1])
         return "v%d" % f.version
     if kind == "section_count":
-        f.section_count = rng.choice([0, 6, 8, 2 ** 32 - 1])
+        f.section_count = rng.choice([0, 5, 7, 2 ** 32 - 1])
         return "sections%d" % f.section_count
     if kind == "group_len":
         # One byte moved between two records (or out of the last).
@@ -3566,7 +3566,7 @@ def hier_edit(rng, f, kind):
                 f.groups[g + 1] = r[-1:] + f.groups[g + 1]
             else:
                 f.trailing = b""
-                f.len_delta[6] = 1
+                f.len_delta[5] = 1
         elif g + 1 < len(f.groups) and f.groups[g + 1]:
             f.groups[g] = r + f.groups[g + 1][:1]
             f.groups[g + 1] = f.groups[g + 1][1:]

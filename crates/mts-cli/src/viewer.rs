@@ -1,28 +1,34 @@
 //! `mts view`: a window (winit) with an orbit camera around one model, the
-//! demo layout ([`DemoScene`]) of an `InstancedScene`, or the parts of a
-//! glTF scene ([`GltfScene`]) in one, drawn by the same renderer as
-//! everything else.
+//! demo layout ([`DemoScene`]) of an `InstancedScene`, the parts of a
+//! glTF scene ([`GltfScene`]) in one, or a view-dependent hierarchy
+//! ([`HierarchyRenderer`], its cut chosen again every frame and culled to
+//! the view), drawn by the same renderer as everything else.
 //!
 //! Controls: drag with the left button (or the arrow keys) to orbit, `W`/`S`
 //! to move closer or farther; the mouse wheel, `Up`/`Down` or `+`/`-`
 //! change the LoD continuously (10% of the triangles per step); `A` toggles
 //! the automatic mode, which picks the coarsest LoD whose error projects
 //! within one pixel ([`mts::lod_for_screen_error`]); in a scene `F` flies
-//! along the demo's path and back to orbiting; `Escape` quits. The
-//! title shows triangles, indices sent, the last extraction's microseconds
-//! and frames per second.
+//! along the demo's path and back to orbiting; `Escape` quits. On a
+//! hierarchy the wheel and keys change the pixel threshold of the cut
+//! (10% per step; `A` goes back to one pixel), `W` comes as near as a
+//! tenth of the bounding radius (down onto a terrain, up to a scan), and
+//! `F` flies a circle low over the bounds, looking ahead and down. The
+//! title shows triangles, indices sent, the last extraction's (or
+//! hierarchy update's) microseconds and frames per second.
 
 use crate::demo_scene::DemoScene;
 use crate::gltf_scene::GltfScene;
 use crate::stdout::warnln;
 use glam::Vec3;
+use mts::hierarchy::{Hierarchy, ViewDependent};
 use mts::model::Extractor;
 use mts::{Error, MtsModel, Result};
 use mts_render::camera::Camera;
 use mts_render::gpu::AdapterReport;
 use mts_render::scene::DEFAULT_PIXEL_ERROR;
 use mts_render::strip_renderer::{RendererConfig, StripRenderer};
-use mts_render::{FrameStats, InstancedScene};
+use mts_render::{FrameStats, HierarchyRenderer, InstancedScene};
 use std::sync::Arc;
 use std::time::Instant;
 use winit::application::ApplicationHandler;
@@ -39,6 +45,10 @@ const LOD_STEP: f64 = 1.1;
 const TITLE_PERIOD: f64 = 0.5;
 /// Seconds of one flight along the scene's path (`F`).
 const FLIGHT_SECONDS: f32 = 40.0;
+/// Nearest orbit distance in bounding radii: outside a model's sphere,
+/// down to the surface of a hierarchy.
+const NEAREST_ORBIT: f32 = 1.05;
+const NEAREST_HIERARCHY_ORBIT: f32 = 0.1;
 
 /// What the viewer shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -109,6 +119,22 @@ pub fn run_gltf(
     run_app(Shown::Gltf { scene, checker }, title, max_frames)
 }
 
+/// [`run`] on a view-dependent hierarchy: its cut for the camera within
+/// [`DEFAULT_PIXEL_ERROR`] (or the threshold the wheel sets), culled to the
+/// view, updated every frame ([`HierarchyRenderer::update`]), with the
+/// checker texture instead of its own when `checker` is set.
+///
+/// # Errors
+/// As [`run`], and those of [`HierarchyRenderer::with_appearance`].
+pub fn run_hierarchy(
+    h: &Hierarchy,
+    checker: bool,
+    title: &str,
+    max_frames: Option<u64>,
+) -> Result<ViewerReport> {
+    run_app(Shown::Hierarchy { h, checker }, title, max_frames)
+}
+
 fn run_app(shown: Shown<'_>, title: &str, max_frames: Option<u64>) -> Result<ViewerReport> {
     let event_loop = EventLoop::new().map_err(|e| Error::Gpu(format!("no event loop: {e}")))?;
     event_loop.set_control_flow(ControlFlow::Poll);
@@ -150,6 +176,10 @@ enum Shown<'m> {
         scene: &'m GltfScene,
         checker: bool,
     },
+    Hierarchy {
+        h: &'m Hierarchy,
+        checker: bool,
+    },
 }
 
 struct App<'m> {
@@ -173,6 +203,8 @@ struct State<'m> {
     orbit: Orbit,
     /// Share of the triangles asked for in manual mode (0..1].
     ratio: f64,
+    /// A hierarchy's pixel threshold in manual mode.
+    pixel_error: f32,
     /// In a scene, when set: flying along the demo's path since then
     /// (`F` toggles), instead of orbiting.
     flying: Option<Instant>,
@@ -199,6 +231,30 @@ enum Drawn<'m> {
     Scene(DemoScene<'m>),
     /// The parts of a glTF scene.
     Parts(InstancedScene<'m>),
+    /// A hierarchy, its cut kept by `view`; `bounds` of its vertices.
+    Hierarchy {
+        renderer: HierarchyRenderer,
+        view: ViewDependent<'m>,
+        bounds: (Vec3, Vec3),
+    },
+}
+
+/// The flight over a hierarchy at `t` (0..1): a circle around the
+/// bounds' centre at about half their width, a tenth of `radius` above
+/// their top, looking one radian ahead along the circle and down to
+/// their middle height.
+fn hierarchy_flight(bounds: (Vec3, Vec3), radius: f32, t: f32, aspect: f32) -> Camera {
+    let (lo, hi) = bounds;
+    let centre = (lo + hi) * 0.5;
+    let ring = 0.55 * (hi.x - lo.x).max(hi.z - lo.z) * 0.5;
+    let at = |a: f32| {
+        let (s, c) = a.sin_cos();
+        Vec3::new(centre.x + ring * c, 0.0, centre.z + ring * s)
+    };
+    let a = std::f32::consts::TAU * t;
+    let eye = at(a) + Vec3::Y * (hi.y + 0.1 * radius);
+    let target = at(a + 1.0) + Vec3::Y * centre.y;
+    Camera::looking(eye, target, aspect, 1e-3 * radius, 3.0 * radius)
 }
 
 /// Orbit camera around `centre`: yaw and pitch in radians, distance in
@@ -290,14 +346,21 @@ impl ApplicationHandler for App<'_> {
                     Key::Named(NamedKey::ArrowLeft) => state.orbit.yaw += 0.1,
                     Key::Named(NamedKey::ArrowRight) => state.orbit.yaw -= 0.1,
                     Key::Character("a" | "A") => state.auto = !state.auto,
-                    Key::Character("f" | "F") if matches!(state.drawn, Drawn::Scene(_)) => {
+                    Key::Character("f" | "F")
+                        if matches!(state.drawn, Drawn::Scene(_) | Drawn::Hierarchy { .. }) =>
+                    {
                         state.flying = match state.flying {
                             Some(_) => None,
                             None => Some(Instant::now()),
                         };
                     }
                     Key::Character("w" | "W") => {
-                        state.orbit.distance = (state.orbit.distance / 1.1).max(1.05);
+                        let nearest = if matches!(state.drawn, Drawn::Hierarchy { .. }) {
+                            NEAREST_HIERARCHY_ORBIT
+                        } else {
+                            NEAREST_ORBIT
+                        };
+                        state.orbit.distance = (state.orbit.distance / 1.1).max(nearest);
                     }
                     Key::Character("s" | "S") => state.orbit.distance *= 1.1,
                     _ => {}
@@ -369,6 +432,26 @@ impl<'m> State<'m> {
             strip_mode: report.strip_mode,
         };
         let (drawn, centre, radius) = match shown {
+            Shown::Hierarchy { h, checker } => {
+                let appearance = mts_render::Appearance { checker };
+                let renderer = HierarchyRenderer::with_appearance(
+                    &device,
+                    &queue,
+                    &renderer_config,
+                    h,
+                    &appearance,
+                )?;
+                for w in renderer.warnings() {
+                    warnln!("{w}");
+                }
+                let (lo, hi) = mts::mesh::bounds_of(h.positions()).unwrap_or_default();
+                let drawn = Drawn::Hierarchy {
+                    renderer,
+                    view: ViewDependent::new(h),
+                    bounds: (lo, hi),
+                };
+                (drawn, (lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-6))
+            }
             Shown::Gltf { scene, checker } => {
                 let appearance = mts_render::Appearance { checker };
                 let (parts, _) = scene.scene(&device, &queue, &renderer_config, &appearance)?;
@@ -445,6 +528,7 @@ impl<'m> State<'m> {
                 distance: 3.0,
             },
             ratio: 1.0,
+            pixel_error: DEFAULT_PIXEL_ERROR,
             flying: None,
             auto: !matches!(
                 shown,
@@ -474,9 +558,22 @@ impl<'m> State<'m> {
         self.depth = depth_view(&self.device, width, height);
     }
 
-    /// Changes the manual LoD by `notches` steps (positive: finer).
+    /// Changes the manual LoD by `notches` steps (positive: finer): a
+    /// share of the triangles, or a hierarchy's pixel threshold (from
+    /// where the automatic mode left it).
     fn step_lod(&mut self, notches: f64) {
         self.ratio = (self.ratio * LOD_STEP.powf(notches)).clamp(1e-4, 1.0);
+        let step = LOD_STEP.powf(-notches) as f32;
+        self.pixel_error = (self.pixel_error * step).clamp(0.05, 1000.0);
+    }
+
+    /// The pixel threshold of a hierarchy's cut now.
+    fn hierarchy_pixel_error(&self) -> f32 {
+        if self.auto {
+            DEFAULT_PIXEL_ERROR
+        } else {
+            self.pixel_error
+        }
     }
 
     /// Triangles and indices drawn by a scene's update (started at
@@ -501,10 +598,29 @@ impl<'m> State<'m> {
                 let t = (since.elapsed().as_secs_f32() / FLIGHT_SECONDS).fract();
                 scene.path_camera(t, aspect)
             }
+            (Drawn::Hierarchy { bounds, .. }, Some(since)) => {
+                let t = (since.elapsed().as_secs_f32() / FLIGHT_SECONDS).fract();
+                hierarchy_flight(*bounds, self.orbit.radius, t, aspect)
+            }
             _ => self.orbit.camera(aspect),
         };
+        let pixel_error = self.hierarchy_pixel_error();
         let t = Instant::now();
         let (triangles, indices) = match &mut self.drawn {
+            Drawn::Hierarchy { renderer, view, .. } => {
+                // Every frame: the cut follows the camera, culled to it.
+                let frame = renderer.update(
+                    &self.device,
+                    &self.queue,
+                    view,
+                    &camera,
+                    h as f32,
+                    pixel_error,
+                    true,
+                )?;
+                self.extract_us = t.elapsed().as_secs_f64() * 1e6;
+                (frame.triangles, frame.indices_sent)
+            }
             Drawn::Model {
                 renderer,
                 extractor,
@@ -579,6 +695,7 @@ impl<'m> State<'m> {
                 Drawn::Model { renderer, .. } => renderer.draw(&mut pass),
                 Drawn::Scene(scene) => scene.draw(&mut pass),
                 Drawn::Parts(scene) => scene.draw(&mut pass),
+                Drawn::Hierarchy { renderer, .. } => renderer.draw(&mut pass),
             }
         }
         self.queue.submit([encoder.finish()]);
@@ -588,13 +705,21 @@ impl<'m> State<'m> {
         let elapsed = self.since.elapsed().as_secs_f64();
         if elapsed >= TITLE_PERIOD {
             let fps = f64::from(self.frames) / elapsed;
+            let (note, work) = match &self.drawn {
+                Drawn::Hierarchy { .. } => (
+                    format!(
+                        " (cut within {pixel_error:.2} px{})",
+                        if self.auto { ", auto" } else { "" }
+                    ),
+                    "update",
+                ),
+                _ if self.auto => (" (auto)".to_owned(), "extraction"),
+                _ => (String::new(), "extraction"),
+            };
             self.status = format!(
-                "mts view: {triangles} triangles{}, {indices} indices sent, extraction {:.0} us, \
+                "mts view: {triangles} triangles{note}, {indices} indices sent, {work} {:.0} us, \
                  {fps:.0} fps ({}, {:?})",
-                if self.auto { " (auto)" } else { "" },
-                self.extract_us,
-                self.report.name,
-                self.report.backend
+                self.extract_us, self.report.name, self.report.backend
             );
             self.window.set_title(&self.status);
             self.frames = 0;
@@ -621,4 +746,30 @@ fn depth_view(device: &wgpu::Device, width: u32, height: u32) -> wgpu::TextureVi
             view_formats: &[],
         })
         .create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The flight over a terrain's bounds stays above them, inside their
+    /// width, and looks ahead and down at ground it can see.
+    #[test]
+    fn the_hierarchy_flight_looks_down_at_the_bounds() {
+        let bounds = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.3, 1.0));
+        let radius = (bounds.1 - bounds.0).length() * 0.5;
+        for i in 0..16 {
+            let t = i as f32 / 16.0;
+            let camera = hierarchy_flight(bounds, radius, t, 1.5);
+            let eye = mts_render::hierarchy::camera_eye(camera.view_proj);
+            assert!(eye.y > bounds.1.y, "{t}: {eye}");
+            assert!(eye.x.abs() < 1.0 && eye.z.abs() < 1.0, "{t}: {eye}");
+            // The middle of the view is ground below the eye.
+            let ahead = camera
+                .view_proj
+                .inverse()
+                .project_point3(Vec3::new(0.0, 0.0, 0.5));
+            assert!(ahead.y < eye.y, "{t}: looks up to {ahead}");
+        }
+    }
 }

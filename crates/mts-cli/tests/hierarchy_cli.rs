@@ -184,8 +184,8 @@ fn a_hierarchy_refuses_what_it_cannot_hold() {
 }
 
 /// `mts bench view-dependent --json`: one row per method with the keys
-/// other tools read, the hierarchy without cracks or popping above the
-/// threshold and drawing less than full detail, lists at 3 indices a
+/// other tools read, the hierarchy without cracks, popping at most twice
+/// the threshold and drawing less than full detail, lists at 3 indices a
 /// triangle, and the image error against the supersampled reference (the
 /// full-detail method's ratio is 1). Without an adapter the command says
 /// so (an error unless `MTS_REQUIRE` names gpu, as in CI).
@@ -244,7 +244,9 @@ fn bench_view_dependent_compares_the_four_methods() {
                 assert_eq!(m["cracks"].as_u64().unwrap(), 0);
                 assert!(drawn < full, "{px} px: {drawn}");
                 assert!(ipt > 1.0 && ipt < 2.0, "{ipt}");
-                assert!(popping <= px, "{px} px: popping {popping}");
+                // Two LoDs each within the threshold of the input may lie
+                // twice the threshold apart; this 24-frame flight is fast.
+                assert!(popping <= 2.0 * px, "{px} px: popping {popping}");
                 assert!(m["triangles_visible_median"].as_f64().unwrap() <= drawn);
             }
             "clusterlod" => {

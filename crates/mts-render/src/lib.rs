@@ -21,12 +21,17 @@
 //!   clipper and fragment invocations; GPU time), where it offers them.
 //! - [`scene`]: many instances of one model, each with its own LoD and
 //!   coherence cache, frustum-culled.
+//! - [`hierarchy`]: [`HierarchyRenderer`], a view-dependent
+//!   [`mts::hierarchy::Hierarchy`] drawn as one strip draw of its
+//!   [`mts::hierarchy::ViewDependent`] arena, only the changed ranges
+//!   written camera after camera.
 //!
 //! The interactive viewer (winit) lives in the `mts` command (`mts-cli`).
 
 pub mod camera;
 pub mod gpu;
 pub mod headless;
+pub mod hierarchy;
 pub mod image_error;
 pub mod scene;
 pub mod stats;
@@ -36,7 +41,11 @@ pub mod texture;
 pub use camera::{Camera, Shading};
 pub use gpu::{AdapterReport, Gpu, StripMode};
 pub use headless::{Difference, HeadlessTarget, Image};
-pub use scene::{BvhUpdate, FrameStats, InstanceId, InstancedScene, ModelId, SceneMemory};
+pub use hierarchy::{HierarchyFrame, HierarchyRenderer};
+pub use scene::{
+    BvhUpdate, FrameStats, HierarchyId, HierarchyInstanceId, InstanceId, InstancedScene, ModelId,
+    SceneMemory,
+};
 pub use stats::{DrawMeasurement, DrawQueries, PipelineCounts};
 pub use strip_renderer::{RendererConfig, StripRenderer, Upload, VERTEX_BYTES};
 pub use texture::Appearance;

@@ -43,12 +43,27 @@
 //! first update with no instance, so an emptied scene holds what a new one
 //! with the same models does. The ground, the layout and the camera of
 //! `mts render --scene` live in the CLI.
+//!
+//! **Hierarchies.** Beside models, a scene holds view-dependent
+//! hierarchies ([`InstancedScene::add_hierarchy`]): each uploads its
+//! vertices once; each of its instances keeps its own cut
+//! ([`ViewDependent`]) and its own index buffer mirroring the cut's arena,
+//! as [`crate::HierarchyRenderer`] does. An update tests each hierarchy
+//! instance's bounding sphere against the frustum (a linear test: they
+//! are few and large), selects the visible ones' cuts for the eye and the
+//! frustum carried into model space ([`crate::hierarchy::instance_view`]),
+//! writes their dirty ranges (restart path) or their stitched arenas, and
+//! places their transforms after the models' groups in the instance
+//! buffer; each is one `draw_indexed` of one instance. A culled instance's
+//! cut is kept as it was, and follows the camera again when it is seen.
 
 use super::camera::Camera;
 use super::gpu::StripMode;
 use super::strip_renderer::{write_index_range, RendererConfig, StripRenderer, INSTANCE_BYTES};
+use crate::hierarchy::{instance_view, vertex_renderer, ArenaIndices, HierarchyFrame};
 use crate::texture::Appearance;
 use glam::{Mat4, Vec3, Vec4};
+use mts::hierarchy::{Hierarchy, ViewDependent};
 use mts::model::Extractor;
 use mts::strip::encode::stitch_restart_buffer;
 use mts::{Error, MtsModel, Result};
@@ -70,6 +85,11 @@ pub const REFITS_BEFORE_REBUILD: u32 = 64;
 /// Most instances an [`InstancedScene`] holds, over all its models.
 pub const MAX_INSTANCES: usize = 1 << 22;
 
+/// Most hierarchy instances an [`InstancedScene`] holds, over all its
+/// hierarchies (each keeps its own cut, O(groups) bytes, and index
+/// buffer).
+pub const MAX_HIERARCHY_INSTANCES: usize = 1 << 12;
+
 /// A model added to a scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct ModelId(u32);
@@ -89,27 +109,50 @@ impl InstanceId {
     }
 }
 
+/// A hierarchy added to a scene ([`InstancedScene::add_hierarchy`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct HierarchyId(u32);
+
+/// An instance of a hierarchy in a scene: valid until it is removed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct HierarchyInstanceId {
+    hierarchy: u32,
+    slot: u32,
+}
+
+impl HierarchyInstanceId {
+    /// The hierarchy this is an instance of.
+    #[must_use]
+    pub fn hierarchy(self) -> HierarchyId {
+        HierarchyId(self.hierarchy)
+    }
+}
+
 /// What one [`InstancedScene::update`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct FrameStats {
-    /// Instances inside the view frustum (drawn).
+    /// Instances inside the view frustum (drawn), of models and of
+    /// hierarchies.
     pub visible: usize,
-    /// Triangles the visible instances draw (their buckets' counts).
+    /// Triangles the visible instances draw (their buckets' counts; a
+    /// hierarchy instance's cut, culled parts left out).
     pub triangles: usize,
     /// Triangles the visible instances would draw at full detail.
     pub triangles_full_detail: usize,
     /// Indices the draws read (restarts, or stitching, included).
     pub indices_drawn: usize,
     /// Visible instances whose bucket changed (or that were not drawn in
-    /// the previous update).
+    /// the previous update); hierarchy instances whose drawn cut changed.
     pub lod_changes: usize,
     /// Buckets extracted by this update.
     pub extractions: usize,
     /// Buckets whose buffers were freed by this update.
     pub evictions: usize,
-    /// Instanced draws recorded ((model, bucket) groups).
+    /// Instanced draws recorded ((model, bucket) groups, and one per
+    /// visible hierarchy instance).
     pub draws: usize,
-    /// Bytes written to the GPU (bucket indices and instance transforms).
+    /// Bytes written to the GPU (bucket indices, hierarchy instances'
+    /// indices and instance transforms).
     pub upload_bytes: usize,
     /// Whether the instance BVH was rebuilt, refitted or kept.
     pub bvh: BvhUpdate,
@@ -163,13 +206,14 @@ pub struct SceneMemory {
     /// CPU bytes per model, shared by its instances: the walking
     /// extractor and the bucket table.
     pub cpu_shared_bytes: usize,
-    /// GPU bytes of the live buckets' index buffers.
+    /// GPU bytes of the live buckets' index buffers (and the hierarchy
+    /// instances').
     pub gpu_index_bytes: usize,
     /// GPU bytes of the instance buffer.
     pub gpu_instance_bytes: usize,
     /// GPU bytes of the models' vertex buffers.
     pub gpu_vertex_bytes: usize,
-    /// Live bucket buffers.
+    /// Live bucket buffers (and hierarchy instances' index buffers).
     pub buffers: usize,
 }
 
@@ -248,8 +292,33 @@ struct ModelEntry<'m> {
     free: Vec<u32>,
 }
 
-/// Several models, each with instances the host places (see the module
-/// docs).
+/// A hierarchy with its vertices and its instances.
+#[derive(Debug)]
+struct HierarchyEntry<'m> {
+    h: &'m Hierarchy,
+    /// The vertices (its own index buffer unused).
+    renderer: StripRenderer,
+    local: Bound,
+    slots: Vec<Option<HierarchyInstance<'m>>>,
+    free: Vec<u32>,
+}
+
+/// One placed copy of a hierarchy: its own cut and index buffer.
+#[derive(Debug)]
+struct HierarchyInstance<'m> {
+    transform: Mat4,
+    bound: Bound,
+    view: ViewDependent<'m>,
+    arena: ArenaIndices,
+    /// What its last update (while visible) did.
+    last: HierarchyFrame,
+    /// Its transform's entry in the instance buffer this update; [`NONE`]
+    /// when culled.
+    entry: u32,
+}
+
+/// Several models, each with instances the host places, and hierarchies
+/// with theirs (see the module docs).
 ///
 /// # Example
 ///
@@ -301,6 +370,8 @@ pub struct InstancedScene<'m> {
     spacing: f32,
     models: Vec<ModelEntry<'m>>,
     live: usize,
+    hierarchies: Vec<HierarchyEntry<'m>>,
+    hierarchy_live: usize,
     /// Instances in the BVH's order, and the BVH over their bounds.
     order: Vec<InstanceId>,
     bvh: Option<obvhs::bvh2::Bvh2>,
@@ -326,6 +397,8 @@ impl std::fmt::Debug for InstancedScene<'_> {
         f.debug_struct("InstancedScene")
             .field("models", &self.models.len())
             .field("instances", &self.live)
+            .field("hierarchies", &self.hierarchies.len())
+            .field("hierarchy_instances", &self.hierarchy_live)
             .field("visible", &self.visible.len())
             .field("bvh_nodes", &self.bvh.as_ref().map_or(0, |b| b.nodes.len()))
             .finish_non_exhaustive()
@@ -342,6 +415,8 @@ impl<'m> InstancedScene<'m> {
             spacing: DEFAULT_BUCKET_SPACING,
             models: Vec::new(),
             live: 0,
+            hierarchies: Vec::new(),
+            hierarchy_live: 0,
             order: Vec::new(),
             bvh: None,
             rebuild: false,
@@ -529,10 +604,179 @@ impl<'m> InstancedScene<'m> {
         true
     }
 
-    /// Instances in the scene, over all models.
+    /// Instances in the scene, over all models (hierarchy instances:
+    /// [`InstancedScene::hierarchy_instance_count`]).
     #[must_use]
     pub fn instance_count(&self) -> usize {
         self.live
+    }
+
+    /// Adds the view-dependent hierarchy `h`: its vertices (and their
+    /// properties and texture, as [`crate::HierarchyRenderer::new`]) are
+    /// uploaded once and shared by its instances, each of which keeps its
+    /// own cut (see the module docs).
+    ///
+    /// # Errors
+    /// As [`crate::HierarchyRenderer::with_appearance`].
+    ///
+    /// Cost: the vertex upload; nothing is selected until an update.
+    pub fn add_hierarchy(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        h: &'m Hierarchy,
+    ) -> Result<HierarchyId> {
+        self.add_hierarchy_with(device, queue, h, &Appearance::default())
+    }
+
+    /// [`InstancedScene::add_hierarchy`] drawn with `appearance`.
+    ///
+    /// # Errors
+    /// As [`InstancedScene::add_hierarchy`].
+    pub fn add_hierarchy_with(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        h: &'m Hierarchy,
+        appearance: &Appearance,
+    ) -> Result<HierarchyId> {
+        if self.hierarchies.len() >= u32::MAX as usize {
+            return Err(Error::InvalidArgument("too many hierarchies".into()));
+        }
+        let renderer = vertex_renderer(device, queue, &self.config, h, appearance)?;
+        let (min, max) = mts::mesh::bounds_of(h.positions()).unwrap_or_default();
+        let diagonal = (mts::mesh::diagonal_of(min, max) as f32).min(f32::MAX);
+        self.hierarchies.push(HierarchyEntry {
+            h,
+            renderer,
+            local: Bound {
+                centre: (min + max) * 0.5,
+                radius: (diagonal * 0.5).max(f32::MIN_POSITIVE),
+            },
+            slots: Vec::new(),
+            free: Vec::new(),
+        });
+        Ok(HierarchyId(self.hierarchies.len() as u32 - 1))
+    }
+
+    /// Adds an instance of hierarchy `id` at `transform` (model to world;
+    /// a rotation, translation and uniform scale keep the pixel threshold
+    /// exact, a non-uniform scale tightens it, see
+    /// [`crate::hierarchy::instance_view`]). It is drawn from the next
+    /// [`InstancedScene::update`] on.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for a hierarchy not of this scene, past
+    /// [`MAX_HIERARCHY_INSTANCES`], or for a transform that is not
+    /// invertible or whose bounds are not finite.
+    ///
+    /// Cost: O(groups + clusters) for the instance's cut tables.
+    pub fn add_hierarchy_instance(
+        &mut self,
+        id: HierarchyId,
+        transform: Mat4,
+    ) -> Result<HierarchyInstanceId> {
+        if self.hierarchy_live >= MAX_HIERARCHY_INSTANCES {
+            return Err(Error::InvalidArgument(format!(
+                "a scene holds at most {MAX_HIERARCHY_INSTANCES} hierarchy instances"
+            )));
+        }
+        let entry = self
+            .hierarchies
+            .get_mut(id.0 as usize)
+            .ok_or_else(|| Error::InvalidArgument(format!("no hierarchy {id:?}")))?;
+        let bound = place_hierarchy(entry.local, transform)?;
+        let instance = HierarchyInstance {
+            transform,
+            bound,
+            view: ViewDependent::new(entry.h),
+            arena: ArenaIndices::default(),
+            last: HierarchyFrame::default(),
+            entry: NONE,
+        };
+        let slot = match entry.free.pop() {
+            Some(i) => {
+                entry.slots[i as usize] = Some(instance);
+                i
+            }
+            None => {
+                entry.slots.push(Some(instance));
+                entry.slots.len() as u32 - 1
+            }
+        };
+        self.hierarchy_live += 1;
+        Ok(HierarchyInstanceId {
+            hierarchy: id.0,
+            slot,
+        })
+    }
+
+    /// Moves hierarchy instance `id` to `transform`; its cut follows at
+    /// the next update (coherently: only what changed is walked).
+    ///
+    /// # Errors
+    /// As [`InstancedScene::add_hierarchy_instance`], and for an instance
+    /// that was removed.
+    pub fn set_hierarchy_transform(
+        &mut self,
+        id: HierarchyInstanceId,
+        transform: Mat4,
+    ) -> Result<()> {
+        let entry = self
+            .hierarchies
+            .get_mut(id.hierarchy as usize)
+            .ok_or_else(|| Error::InvalidArgument(format!("no instance {id:?}")))?;
+        let local = entry.local;
+        let instance = entry
+            .slots
+            .get_mut(id.slot as usize)
+            .and_then(Option::as_mut)
+            .ok_or_else(|| Error::InvalidArgument(format!("no instance {id:?}")))?;
+        instance.bound = place_hierarchy(local, transform)?;
+        instance.transform = transform;
+        Ok(())
+    }
+
+    /// Removes hierarchy instance `id` (its cut and index buffer go; its
+    /// slot is reused). Returns whether it was there.
+    pub fn remove_hierarchy_instance(&mut self, id: HierarchyInstanceId) -> bool {
+        let Some(entry) = self.hierarchies.get_mut(id.hierarchy as usize) else {
+            return false;
+        };
+        let Some(slot) = entry.slots.get_mut(id.slot as usize) else {
+            return false;
+        };
+        if slot.take().is_none() {
+            return false;
+        }
+        entry.free.push(id.slot);
+        if entry.free.len() == entry.slots.len() {
+            entry.slots = Vec::new();
+            entry.free = Vec::new();
+        }
+        self.hierarchy_live -= 1;
+        true
+    }
+
+    /// Hierarchy instances in the scene, over all hierarchies.
+    #[must_use]
+    pub fn hierarchy_instance_count(&self) -> usize {
+        self.hierarchy_live
+    }
+
+    /// What the last update did for hierarchy instance `id` and what it
+    /// draws (as [`crate::HierarchyRenderer::update`] reports it; its
+    /// `gpu_bytes` are its index buffer's); `None` when that update culled
+    /// it whole, or it is removed.
+    #[must_use]
+    pub fn hierarchy_frame(&self, id: HierarchyInstanceId) -> Option<HierarchyFrame> {
+        let instance = self
+            .hierarchies
+            .get(id.hierarchy as usize)?
+            .slots
+            .get(id.slot as usize)?
+            .as_ref()?;
+        (instance.entry != NONE).then_some(instance.last)
     }
 
     /// The bounding sphere (centre, radius) of instance `id` in world
@@ -647,6 +891,18 @@ impl<'m> InstancedScene<'m> {
                 + bvh.primitives_to_nodes.capacity() * 4
                 + bvh.parents.capacity() * 4;
         }
+        for entry in &self.hierarchies {
+            m.cpu_instance_bytes += entry.slots.capacity()
+                * std::mem::size_of::<Option<HierarchyInstance<'_>>>()
+                + entry.free.capacity() * 4;
+            m.gpu_vertex_bytes += entry.renderer.vertex_count() * crate::VERTEX_BYTES;
+            for instance in entry.slots.iter().flatten() {
+                m.cpu_instance_bytes += instance.view.memory_bytes();
+                let bytes = instance.arena.gpu_bytes();
+                m.gpu_index_bytes += bytes;
+                m.buffers += usize::from(bytes > 0);
+            }
+        }
         m.gpu_instance_bytes = self
             .instance_buffer
             .as_ref()
@@ -689,7 +945,11 @@ impl<'m> InstancedScene<'m> {
         for entry in &mut self.models {
             entry.renderer.set_camera(queue, camera);
         }
+        for entry in &mut self.hierarchies {
+            entry.renderer.set_camera(queue, camera);
+        }
         stats.bvh = self.update_bvh();
+        let planes = frustum_planes(camera.view_proj);
         {
             let (order, models) = (&self.order, &self.models);
             cull(
@@ -698,7 +958,7 @@ impl<'m> InstancedScene<'m> {
                     let id = order[p as usize];
                     models[id.model as usize].slots[id.slot as usize].bound
                 },
-                &frustum_planes(camera.view_proj),
+                &planes,
                 &mut self.stack,
                 &mut self.candidates,
             );
@@ -791,9 +1051,64 @@ impl<'m> InstancedScene<'m> {
                 stats.indices_drawn += b.users as usize * b.len as usize;
             }
         }
-        stats.upload_bytes += self.write_transforms(device, queue, groups as usize)?;
         stats.visible = self.visible.len();
-        if self.live == 0 {
+        // Hierarchy instances: each seen one's cut follows the camera in
+        // its model space; transforms after the models' groups.
+        let mut entries = groups;
+        for entry in &mut self.hierarchies {
+            let format = entry.renderer.index_format();
+            for instance in entry.slots.iter_mut().flatten() {
+                instance.entry = NONE;
+                let b = instance.bound;
+                if !sphere_in_frustum(&planes, b.centre, b.radius) {
+                    continue;
+                }
+                // Checked when placed: the transform is invertible.
+                let Some(view) = instance_view(
+                    camera,
+                    instance.transform,
+                    viewport_height,
+                    pixel_error,
+                    true,
+                ) else {
+                    continue;
+                };
+                let update = instance.view.update(&view);
+                let upload = instance.arena.update(
+                    device,
+                    queue,
+                    format,
+                    self.config.strip_mode,
+                    instance.view.buffer(),
+                    instance.view.dirty_ranges(),
+                )?;
+                instance.last = HierarchyFrame {
+                    update,
+                    triangles: instance.view.triangle_count(),
+                    indices_sent: instance.view.indices_sent(),
+                    indices_drawn: instance.arena.indices_drawn(),
+                    upload,
+                    gpu_bytes: instance.arena.gpu_bytes(),
+                    cpu_bytes: instance.view.memory_bytes(),
+                };
+                instance.entry = entries;
+                entries += 1;
+                let changed = update.groups_entered
+                    + update.groups_left
+                    + update.groups_changed
+                    + update.clusters_entered
+                    + update.clusters_left;
+                stats.visible += 1;
+                stats.lod_changes += usize::from(changed > 0);
+                stats.triangles += instance.last.triangles;
+                stats.triangles_full_detail += entry.h.triangle_count();
+                stats.indices_drawn += instance.last.indices_drawn;
+                stats.upload_bytes += upload.bytes;
+                stats.draws += usize::from(instance.last.indices_drawn > 0);
+            }
+        }
+        stats.upload_bytes += self.write_transforms(device, queue, entries as usize)?;
+        if self.live == 0 && self.hierarchy_live == 0 {
             // Emptied: the per-update lists and the instance buffer are
             // given back, as a new scene has none.
             self.order = Vec::new();
@@ -808,8 +1123,9 @@ impl<'m> InstancedScene<'m> {
     }
 
     /// Writes the visible instances' transforms, each at its bucket's
-    /// group; grows the instance buffer (doubling) when needed. Returns
-    /// the bytes written.
+    /// group, and the visible hierarchy instances' at their entries; grows
+    /// the instance buffer (doubling) when needed. Returns the bytes
+    /// written.
     fn write_transforms(
         &mut self,
         device: &wgpu::Device,
@@ -858,14 +1174,27 @@ impl<'m> InstancedScene<'m> {
             view.slice(at..at + INSTANCE_BYTES as usize)
                 .copy_from_slice(bytemuck::cast_slice(&slot.transform.to_cols_array()));
         }
+        for instance in self
+            .hierarchies
+            .iter()
+            .flat_map(|e| e.slots.iter().flatten())
+        {
+            if instance.entry == NONE {
+                continue;
+            }
+            let at = instance.entry as usize * INSTANCE_BYTES as usize;
+            view.slice(at..at + INSTANCE_BYTES as usize)
+                .copy_from_slice(bytemuck::cast_slice(&instance.transform.to_cols_array()));
+        }
         Ok(size as usize)
     }
 
     /// Records one instanced draw per (model, bucket) with visible
-    /// instances into `pass`.
+    /// instances into `pass`, then one draw per visible hierarchy
+    /// instance.
     ///
-    /// Cost: three binds per model with visible instances plus one
-    /// `draw_indexed` per group.
+    /// Cost: three binds per model or hierarchy with visible instances
+    /// plus one `draw_indexed` per group or hierarchy instance.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
         let Some(instances) = &self.instance_buffer else {
             return;
@@ -886,6 +1215,23 @@ impl<'m> InstancedScene<'m> {
                 }
                 pass.set_index_buffer(buffer.slice(..), entry.renderer.index_format());
                 pass.draw_indexed(0..b.len, 0, b.first..b.first + b.users);
+            }
+        }
+        for entry in &self.hierarchies {
+            let mut bound = false;
+            for instance in entry.slots.iter().flatten() {
+                if instance.entry == NONE || instance.arena.indices_drawn() == 0 {
+                    continue;
+                }
+                if !bound {
+                    entry.renderer.bind(pass, true);
+                    pass.set_vertex_buffer(1, instances.slice(..));
+                    bound = true;
+                }
+                let e = instance.entry;
+                instance
+                    .arena
+                    .draw(pass, entry.renderer.index_format(), e..e + 1);
             }
         }
     }
@@ -999,6 +1345,24 @@ fn index_buffer(
         )
     };
     Ok((buffer, bytes))
+}
+
+/// The world-space bound of a hierarchy instance (as [`place`]), once its
+/// transform is known to be invertible with every axis scale above 0 (the
+/// cut is selected in model space).
+fn place_hierarchy(local: Bound, transform: Mat4) -> Result<Bound> {
+    let (bound, _) = place(local, transform)?;
+    let invertible = [transform.x_axis, transform.y_axis, transform.z_axis]
+        .iter()
+        .all(|c| c.truncate().length() > 0.0)
+        && transform.inverse().is_finite()
+        && transform.determinant() != 0.0;
+    if !invertible {
+        return Err(Error::InvalidArgument(format!(
+            "a hierarchy instance's transform must be invertible: {transform}"
+        )));
+    }
+    Ok(bound)
 }
 
 /// The box around a bound.

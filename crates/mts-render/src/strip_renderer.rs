@@ -721,10 +721,25 @@ impl StripRenderer {
         if self.draw.is_empty() {
             return;
         }
-        self.bind(pass, self.content == Content::Strips);
-        pass.set_vertex_buffer(1, self.identity_instance.slice(..));
+        self.bind_single(pass, self.content == Content::Strips);
         pass.set_index_buffer(index_buffer.slice(..), self.index_format);
         pass.draw_indexed(self.draw.clone(), 0, 0..1);
+    }
+
+    /// [`StripRenderer::bind`] with the identity transform as the one
+    /// instance (slot 1): the caller binds indices and draws one instance,
+    /// as [`crate::hierarchy::HierarchyRenderer`] does with its own index
+    /// buffer.
+    pub(crate) fn bind_single(&self, pass: &mut wgpu::RenderPass<'_>, strips: bool) {
+        self.bind(pass, strips);
+        pass.set_vertex_buffer(1, self.identity_instance.slice(..));
+    }
+
+    /// GPU bytes of its vertex buffer and of its own index buffer (the
+    /// texture, the camera uniform and the pipelines left out).
+    #[must_use]
+    pub fn gpu_bytes(&self) -> usize {
+        self.vertex_count * VERTEX_BYTES + self.index_capacity * self.index_size()
     }
 
     /// Sets the strip (`strips`) or list pipeline, the camera and the
@@ -908,7 +923,9 @@ fn to_u32_range(r: Range<usize>) -> Range<u32> {
     r.start as u32..r.end as u32
 }
 
-fn check_size(device: &wgpu::Device, bytes: usize, what: &str) -> Result<()> {
+/// [`Error::Gpu`] when a buffer of `bytes` exceeds the device's
+/// `max_buffer_size`.
+pub(crate) fn check_size(device: &wgpu::Device, bytes: usize, what: &str) -> Result<()> {
     let max = device.limits().max_buffer_size;
     if bytes as u64 > max {
         return Err(Error::Gpu(format!(

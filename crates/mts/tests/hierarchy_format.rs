@@ -151,19 +151,19 @@ fn set_varint(payload: &[u8], at: usize, v: u64) -> Vec<u8> {
 /// Group `g`'s record of `bytes` replaced by `record`, lengths fixed,
 /// resealed.
 fn with_group(bytes: &[u8], g: usize, record: &[u8]) -> Vec<u8> {
-    let (_, start, len) = sections(bytes)[6];
+    let (_, start, len) = sections(bytes)[5];
     let grps = &bytes[start..start + len];
     let (at, n) = group_records(grps)[g];
     let mut new = grps[..at - 8].to_vec();
     new.extend_from_slice(&(record.len() as u64).to_le_bytes());
     new.extend_from_slice(record);
     new.extend_from_slice(&grps[at + n..]);
-    with_section(bytes, 6, &new)
+    with_section(bytes, 5, &new)
 }
 
 /// Group `g`'s record in `bytes`.
 fn group_record(bytes: &[u8], g: usize) -> Vec<u8> {
-    let (_, start, len) = sections(bytes)[6];
+    let (_, start, len) = sections(bytes)[5];
     let grps = &bytes[start..start + len];
     let (at, n) = group_records(grps)[g];
     grps[at..at + n].to_vec()
@@ -327,8 +327,8 @@ fn a_flipped_byte_in_each_section_is_an_error() {
         .into_iter()
         .map(|(tag, start, len)| (String::from_utf8_lossy(&tag).into_owned(), start, len))
         .collect();
-    assert_eq!(places.len(), 7);
-    let (_, grps, _) = sections(&bytes)[6];
+    assert_eq!(places.len(), 6);
+    let (_, grps, _) = sections(&bytes)[5];
     let first = group_records(&bytes[grps..])[0].0 + grps;
     let record = group_record(&bytes, 0);
     for (tag, start, len) in group_layout(&record).3 {

@@ -1,7 +1,9 @@
 //! PNG charts of `mts bench`'s results (plotters, bitmap backend, DejaVu
 //! Sans embedded so no system font is needed).
 
-use crate::bench::results::{Figure6Row, Level, Model, Results, ScaleRow};
+use crate::bench::results::{
+    Figure6Row, Level, Model, Results, ScaleRow, ViewDependentRun, VIEW_DEPENDENT_METHODS,
+};
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -47,7 +49,137 @@ pub fn write_all(dir: &Path, results: &Results) -> Result<Vec<PathBuf>> {
         mts::output::write_through(&path, |p| scale_chart(p, &scale.rows))?;
         written.push(path);
     }
+    if let Some(run) = view_dependent_focus(&results.view_dependent) {
+        let path = dir.join("view_dependent.png");
+        mts::output::write_through(&path, |p| view_dependent_chart(p, run))?;
+        written.push(path);
+    }
     Ok(written)
+}
+
+/// The view-dependent run the chart shows: the largest terrain (flown
+/// over), otherwise the largest input.
+pub fn view_dependent_focus(runs: &[ViewDependentRun]) -> Option<&ViewDependentRun> {
+    runs.iter()
+        .filter(|r| r.flight == "over")
+        .max_by_key(|r| r.triangles_full_detail)
+        .or_else(|| runs.iter().max_by_key(|r| r.triangles_full_detail))
+}
+
+/// Triangles drawn (median frame) as a share of full detail: a group of
+/// bars per pixel threshold, one bar per method, its count above it.
+fn view_dependent_chart(path: &Path, run: &ViewDependentRun) -> Result<()> {
+    let mut thresholds: Vec<f64> = Vec::new();
+    for r in &run.methods {
+        if !thresholds.contains(&r.pixel_threshold) {
+            thresholds.push(r.pixel_threshold);
+        }
+    }
+    let full = run.triangles_full_detail.max(1) as f64;
+    let groups = thresholds.len() as f64;
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "Triangles drawn per frame (median), {}, {} frames {} it",
+                run.input,
+                run.frames,
+                if run.flight == "over" {
+                    "flying over"
+                } else {
+                    "circling"
+                }
+            ),
+            (FONT, 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(-0.5f64..groups - 0.5, 0f64..150.0)
+        .map_err(err)?;
+    let label = |x: &f64| {
+        let i = x.round();
+        match thresholds.get(i as usize) {
+            Some(px) if (x - i).abs() < 1e-6 && i >= 0.0 => format!("{px} px"),
+            _ => String::new(),
+        }
+    };
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(thresholds.len() + 1)
+        .x_label_formatter(&label)
+        .y_label_formatter(&|y| format!("{y:.0}"))
+        .x_desc("pixel threshold")
+        .y_desc(format!(
+            "share of the full detail's {} triangles (%)",
+            run.triangles_full_detail
+        ))
+        .label_style((FONT, 14))
+        .draw()
+        .map_err(err)?;
+    let methods = [
+        ("strip hierarchy (mts_hierarchy)", BLUE),
+        ("meshoptimizer cluster LoD", RED),
+        ("cluster tree", RGBColor(0, 140, 0)),
+        ("per-object MTS", RGBColor(150, 60, 170)),
+    ];
+    let width = 0.8 / methods.len() as f64;
+    for (k, (method, (name, color))) in VIEW_DEPENDENT_METHODS.iter().zip(methods).enumerate() {
+        let bars: Vec<(f64, f64, f64)> = thresholds
+            .iter()
+            .enumerate()
+            .filter_map(|(i, px)| {
+                let r = run
+                    .methods
+                    .iter()
+                    .find(|r| r.method == *method && r.pixel_threshold == *px)?;
+                let x = i as f64 - 0.4 + width * k as f64;
+                Some((
+                    x,
+                    100.0 * r.triangles_drawn_median / full,
+                    r.triangles_drawn_median,
+                ))
+            })
+            .collect();
+        chart
+            .draw_series(bars.iter().map(|&(x, y, _)| {
+                Rectangle::new([(x + 0.01, 0.0), (x + width - 0.01, y)], color.filled())
+            }))
+            .map_err(err)?
+            .label(name)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], color.filled()));
+        chart
+            .draw_series(bars.iter().map(|&(x, y, n)| {
+                let text = if n >= 1e6 {
+                    format!("{:.2}M", n / 1e6)
+                } else {
+                    format!("{:.1}k", n / 1e3)
+                };
+                Text::new(
+                    text,
+                    (x + 0.01, y + 2.0),
+                    (FONT, 12).into_font().color(&BLACK).pos(
+                        plotters::style::text_anchor::Pos::new(
+                            plotters::style::text_anchor::HPos::Left,
+                            plotters::style::text_anchor::VPos::Bottom,
+                        ),
+                    ),
+                )
+            }))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .label_font((FONT, 14))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
 }
 
 /// Indices per triangle against the share of triangles (log axis): MTS

@@ -11,7 +11,7 @@
 use crate::bench::results::{
     BuildMs, Bytes, Distance, Extraction, FastSimplification, FastSimplificationRun, Level,
     Machine, Model, PeerDistance, PropertyRow, PropertySide, Quality, Results, Scale,
-    ScaleExponent, ScaleRow, Scene, Simplify, StripRow, Stripify,
+    ScaleExponent, ScaleRow, Scene, Simplify, StripRow, Stripify, ViewDependentRun,
 };
 use anyhow::{Context, Result};
 use mts::model::{build_from_mesh, requests, PipelineOptions};
@@ -70,6 +70,32 @@ const SCENE_PREFERRED: [&str; 8] = [
 ];
 
 const SCENE_MODELS: usize = 8;
+
+/// The view-dependent section (`mts bench view-dependent` per input): the
+/// generated terrain at each of [`VIEW_DEPENDENT_THRESHOLDS`], then the
+/// scans of [`VIEW_DEPENDENT_SCANS`] measured by this run (the largest
+/// shared ones) at 1 pixel, [`VIEW_DEPENDENT_FRAMES`] frames in a viewport
+/// of [`VIEW_DEPENDENT_SIZE`]; with `--quick` a smaller terrain at 1 pixel,
+/// fewer frames, a smaller viewport.
+pub const VIEW_DEPENDENT_TERRAIN: &str = "terrain:4M";
+
+pub const VIEW_DEPENDENT_THRESHOLDS: [f32; 3] = [0.5, 1.0, 2.0];
+
+pub const VIEW_DEPENDENT_SCANS: [&str; 2] = ["lucy.ply", "armadillo.obj"];
+
+const VIEW_DEPENDENT_SCAN_THRESHOLDS: [f32; 1] = [1.0];
+
+pub const VIEW_DEPENDENT_FRAMES: usize = 300;
+
+pub const VIEW_DEPENDENT_SIZE: (u32, u32) = (640, 360);
+
+pub const QUICK_VIEW_DEPENDENT_TERRAIN: &str = "terrain:100k";
+
+pub const QUICK_VIEW_DEPENDENT_THRESHOLDS: [f32; 1] = [1.0];
+
+pub const QUICK_VIEW_DEPENDENT_FRAMES: usize = 120;
+
+pub const QUICK_VIEW_DEPENDENT_SIZE: (u32, u32) = (320, 180);
 
 /// What to measure.
 pub struct BenchOptions {
@@ -179,6 +205,8 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
     }
     let scenes = measure_scenes(&scene_models, options.quick, frames, &renderer, progress)?;
     drop(scene_models);
+    let view_dependent =
+        measure_view_dependent(&inputs, options.quick, renderer.is_ok(), progress)?;
     let scale = if options.quick {
         None
     } else {
@@ -206,7 +234,66 @@ pub fn run(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Results> {
         scenes,
         vertex_work,
         properties,
+        view_dependent,
     })
+}
+
+/// The view-dependent runs (see [`VIEW_DEPENDENT_TERRAIN`]): each input
+/// flown with the hierarchy's default settings, the images compared with
+/// full detail when `images` (an adapter was found).
+///
+/// # Errors
+/// As [`super::view_dependent::measure`].
+fn measure_view_dependent(
+    inputs: &[(String, Mesh)],
+    quick: bool,
+    images: bool,
+    progress: &dyn Fn(&str),
+) -> Result<Vec<ViewDependentRun>> {
+    let (terrain, thresholds, frames, (width, height)): (&str, &[f32], _, _) = if quick {
+        (
+            QUICK_VIEW_DEPENDENT_TERRAIN,
+            &QUICK_VIEW_DEPENDENT_THRESHOLDS,
+            QUICK_VIEW_DEPENDENT_FRAMES,
+            QUICK_VIEW_DEPENDENT_SIZE,
+        )
+    } else {
+        (
+            VIEW_DEPENDENT_TERRAIN,
+            &VIEW_DEPENDENT_THRESHOLDS,
+            VIEW_DEPENDENT_FRAMES,
+            VIEW_DEPENDENT_SIZE,
+        )
+    };
+    let fly = |mesh: &Mesh, name: &str, pixel_errors: &[f32]| {
+        let spec = super::view_dependent::FlightSpec {
+            mesh,
+            name,
+            pixel_errors,
+            frames,
+            width,
+            height,
+            images,
+            options: Default::default(),
+        };
+        // Told each build; the flights follow the last.
+        let say = |what: &str| {
+            progress(&format!(
+                "view-dependent {name} at {pixel_errors:?} px: building {what}, then the flights"
+            ));
+            Ok(())
+        };
+        super::view_dependent::measure(&spec, &say)
+    };
+    let g: mts::mesh::generate::Generated = terrain.parse().expect("a valid generated name");
+    let mut runs = vec![fly(&g.build(), &format!("generated {g}"), thresholds)?];
+    // The scans this run measured (a file missing or refused is not).
+    for scan in VIEW_DEPENDENT_SCANS.iter().filter(|_| !quick) {
+        if let Some((name, mesh)) = inputs.iter().find(|(n, _)| n == scan) {
+            runs.push(fly(mesh, name, &VIEW_DEPENDENT_SCAN_THRESHOLDS)?);
+        }
+    }
+    Ok(runs)
 }
 
 /// The generated mesh with properties every run measures (UV seams,

@@ -8,8 +8,10 @@
 //! section names the CPU they come from.
 
 use super::measure::{PROPERTY_MESH, SAMPLES};
+use super::view_dependent::COMPARED_FRAMES;
 use crate::bench::results::{
     FastSimplificationRun, Figure6Row, MethodRow, Model, PropertyRow, Results, Scale, Scene,
+    ViewDependentRun,
 };
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
@@ -127,6 +129,82 @@ pub fn scene_table_row(r: &Scene) -> String {
         share(r.coverage_differing_pixel_share),
         r.image_error_ratio.map_or("—".into(), |x| format!("{x:.3}")),
     )
+}
+
+/// The report's section on view-dependent detail: a table per input.
+fn view_dependent_section(s: &mut String, results: &Results) {
+    let runs = &results.view_dependent;
+    if runs.is_empty() {
+        return;
+    }
+    let _ = writeln!(s, "\n## View-dependent detail\n");
+    let _ = writeln!(s, "`mts bench view-dependent` per input: every method that varies its resolution within one object — the strip hierarchy (`mts_hierarchy`), meshoptimizer's cluster LoD (`clusterlod`), the cluster tree's variable resolution (`cluster_tree`) — and the per-object MTS model (`mts`), with the same cameras and pixel threshold along a fixed flight: low over a terrain from one corner to the opposite one, looking ahead and down; around any other mesh once and a half, closing in from 2.2 to 0.8 bounding radii. Triangles: the median frame's cut, not culled, and over the cluster LoD's at the same threshold; update: the selection and extraction (medians and 99th percentiles of the frames); cracks: edges, taken by point, drawn a different number of times in each direction away from the input's boundary, summed over the frames; popping: the largest distance in pixels from a vertex drawn in one frame but not the next to the surface the next frame draws, both ways; memory and GPU bytes (vertices and the flight's largest index buffer) over the raw mesh (12 bytes a vertex and a triangle); image error: on {COMPARED_FRAMES} frames of the flight, the RMSE against the full-detail frame drawn 4 × 4 times denser and box-filtered, over the full-detail frame's at one sample per pixel, pooled (1: as close to the truth as drawing everything).\n");
+    if runs.iter().all(|r| r.adapter.is_none()) {
+        let _ = writeln!(
+            s,
+            "Image error not measured: {}.\n",
+            results
+                .machine
+                .adapter_note
+                .as_deref()
+                .unwrap_or("no adapter")
+        );
+    }
+    for (i, run) in runs.iter().enumerate() {
+        if i > 0 {
+            let _ = writeln!(s);
+        }
+        view_dependent_table(s, run);
+    }
+}
+
+/// One input's table of [`view_dependent_section`].
+fn view_dependent_table(s: &mut String, run: &ViewDependentRun) {
+    let _ = writeln!(
+        s,
+        "### {}: {} triangles, {} frames {} it, {}×{} pixels{}\n",
+        run.input,
+        run.triangles_full_detail,
+        run.frames,
+        if run.flight == "over" {
+            "flying over"
+        } else {
+            "circling"
+        },
+        run.width,
+        run.height,
+        run.adapter
+            .as_ref()
+            .map_or(String::new(), |a| format!(", images on {a}"))
+    );
+    let _ = writeln!(s, "| method | px | triangles drawn (× cluster LoD) | indices / triangle | update ms median / p99 | cracks | popping px max | memory / raw | GPU bytes / raw | build s | image error (× full detail's) |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in &run.methods {
+        let clusterlod = run
+            .methods
+            .iter()
+            .find(|c| c.method == "clusterlod" && c.pixel_threshold == r.pixel_threshold)
+            .map_or(f64::NAN, |c| c.triangles_drawn_median);
+        let raw = r.raw_bytes.max(1) as f64;
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.0} ({:.2}×) | {:.3} | {:.3} / {:.3} | {} | {:.2} | {:.2} | {:.2} | {:.1} | {} |",
+            r.method,
+            r.pixel_threshold,
+            r.triangles_drawn_median,
+            r.triangles_drawn_median / clusterlod,
+            r.indices_per_triangle,
+            r.update_ms_median,
+            r.update_ms_p99,
+            r.cracks,
+            r.popping_px_max,
+            r.memory_bytes as f64 / raw,
+            r.gpu_bytes as f64 / raw,
+            r.build_ms / 1e3,
+            r.image_error_ratio
+                .map_or("—".into(), |x| format!("{x:.3}")),
+        );
+    }
 }
 
 /// The report's section on vertex properties.
@@ -619,6 +697,7 @@ pub fn report(results: &Results) -> String {
         }
     }
     scene_table(&mut s, &results.scenes);
+    view_dependent_section(&mut s, results);
     if let Some(scale) = &results.scale {
         let _ = writeln!(s, "\n## Scale: generated icospheres\n");
         scale_table(&mut s, scale);
@@ -688,6 +767,53 @@ mod tests {
             first.map(|i| i + 1),
             first.and_then(|i| text.lines().nth(i)),
             first.and_then(|i| committed.lines().nth(i)),
+        );
+    }
+
+    /// A `mts bench --quick` run's results.json (`tests/data/bench_quick.json`;
+    /// a schema change fails here until it is made again with `mts bench
+    /// --quick --out DIR`): `bench check --quick` accepts it, and its report
+    /// has the view-dependent section after the scene, a row per method, the
+    /// chart, and the README summary's line.
+    #[test]
+    fn a_quick_run_has_its_view_dependent_section() {
+        use crate::bench::results::VIEW_DEPENDENT_METHODS;
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/bench_quick.json");
+        let results = Results::load(Path::new(path)).unwrap();
+        assert_eq!(
+            crate::bench::check::check(&results, true),
+            Vec::<String>::new()
+        );
+        let dir = std::env::temp_dir().join(format!("mts-report-quick-{}", std::process::id()));
+        write(&dir, &results).unwrap();
+        let text = std::fs::read_to_string(dir.join("report.md")).unwrap();
+        let chart = dir.join("view_dependent.png").is_file();
+        std::fs::remove_dir_all(&dir).ok();
+        assert!(chart, "no view_dependent.png");
+        let (scene, at) = (
+            text.find("\n## Scene:").expect("the scene section"),
+            text.find("\n## View-dependent detail\n")
+                .expect("the view-dependent section"),
+        );
+        assert!(scene < at);
+        let section = &text[at..];
+        let section = &section[..section[1..].find("\n## ").map_or(section.len(), |i| i + 1)];
+        assert!(
+            section.contains("### generated terrain:100000: 100352 triangles, 120 frames flying over it, 320×180 pixels"),
+            "{section}"
+        );
+        for m in VIEW_DEPENDENT_METHODS {
+            assert!(
+                section.contains(&format!("\n| {m} | 1 | ")),
+                "{m}: {section}"
+            );
+        }
+        assert!(text.contains("![view_dependent.png](view_dependent.png)"));
+        let summary = crate::bench::summary::summary(&results, "dir");
+        assert!(
+            summary.contains("View-dependent detail (generated terrain:100000, 1 px")
+                && summary.contains("![view_dependent](dir/view_dependent.png)"),
+            "{summary}"
         );
     }
 }

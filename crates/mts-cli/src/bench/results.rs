@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 7;
+pub const SCHEMA_VERSION: u32 = 8;
 
 /// Steps (of 255) an RGB byte may move before an image comparison
 /// (Figure 6's, the scene's, the properties') counts the pixel as changed.
@@ -38,6 +38,67 @@ pub struct Results {
     /// Vertex properties against meshoptimizer's `simplifyWithAttributes`:
     /// one row per model with properties and share.
     pub properties: Vec<PropertyRow>,
+    /// `mts bench view-dependent` per input: the strip hierarchy, the
+    /// cluster LoD, the cluster tree and per-object MTS along one flight.
+    pub view_dependent: Vec<ViewDependentRun>,
+}
+
+/// One input flown over or around (`mts bench view-dependent`, whose
+/// `--json` prints this): every method at every pixel threshold.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViewDependentRun {
+    pub input: String,
+    pub triangles_full_detail: u64,
+    pub vertices: u64,
+    /// 12 bytes a vertex and a triangle (32-bit indices).
+    pub raw_bytes: u64,
+    /// `over` (a terrain, corner to corner) or `around` (circled, closing in).
+    pub flight: String,
+    pub frames: u64,
+    pub width: u32,
+    pub height: u32,
+    /// The adapter the images came from; `None` without images.
+    pub adapter: Option<String>,
+    /// Per threshold, the methods in the order of [`VIEW_DEPENDENT_METHODS`].
+    pub methods: Vec<ViewDependentRow>,
+}
+
+/// The methods of a [`ViewDependentRun`], in their order per threshold.
+pub const VIEW_DEPENDENT_METHODS: [&str; 4] =
+    ["mts_hierarchy", "clusterlod", "cluster_tree", "mts"];
+
+/// One method at one pixel threshold along the flight.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViewDependentRow {
+    pub method: String,
+    pub pixel_threshold: f64,
+    pub triangles_drawn_median: f64,
+    pub triangles_drawn_max: u64,
+    pub triangles_full_detail: u64,
+    /// Hierarchy only: the median of what frustum culling keeps.
+    pub triangles_visible_median: Option<f64>,
+    /// Indices sent over triangles drawn: the median frame's.
+    pub indices_per_triangle: f64,
+    /// The worst frame's.
+    pub indices_per_triangle_max: f64,
+    pub update_ms_median: f64,
+    pub update_ms_p99: f64,
+    /// Crack edges summed over every frame.
+    pub cracks: u64,
+    pub popping_px_max: f64,
+    pub popping_px_median: f64,
+    pub triangles_changed_median: f64,
+    /// What the method holds in memory to select and extract.
+    pub memory_bytes: u64,
+    pub raw_bytes: u64,
+    /// Vertices plus the largest index buffer of the flight, as uploaded
+    /// (4-byte indices).
+    pub gpu_bytes: u64,
+    pub build_ms: f64,
+    /// `null` without images.
+    pub image_error_ratio: Option<f64>,
 }
 
 /// One model with properties at one share: ours and meshoptimizer's
@@ -536,11 +597,19 @@ mod tests {
                 _ => {}
             }
         }
+        // The committed report's keys, and a quick run's (its view-dependent
+        // run: the committed report may have none).
+        let quick = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/bench_quick.json");
         let mut all = std::collections::BTreeSet::new();
-        keys(
-            &serde_json::to_value(Results::from_value(committed()).unwrap()).unwrap(),
-            &mut all,
-        );
+        for value in [
+            committed(),
+            serde_json::to_value(Results::load(Path::new(quick)).unwrap()).unwrap(),
+        ] {
+            keys(
+                &serde_json::to_value(Results::from_value(value).unwrap()).unwrap(),
+                &mut all,
+            );
+        }
         let missing: Vec<_> = all
             .iter()
             .filter(|k| !doc.contains(&format!("\"{k}\"")) && !doc.contains(&format!("{k}:")))

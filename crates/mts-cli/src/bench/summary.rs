@@ -6,6 +6,7 @@
 //! `--readme` rewrites it there, `--check` fails when it differs from what
 //! the data gives (a test runs that on the committed report).
 
+use super::charts::view_dependent_focus;
 use super::report::{figure6_row, machine_words};
 use crate::bench::results::{MethodRow, Model, Results, ScaleRow};
 use std::fmt::Write as _;
@@ -82,6 +83,7 @@ pub fn summary(results: &Results, report_dir: &str) -> String {
         methods(&mut s, b, models);
         render(&mut s, results, b);
     }
+    view_dependent(&mut s, results, report_dir);
     // The charts `mts bench` draws from the same data.
     let mut charts = Vec::new();
     if let Some(b) = focus(models) {
@@ -92,6 +94,9 @@ pub fn summary(results: &Results, report_dir: &str) -> String {
     }
     if results.scale.is_some() {
         charts.push("scale");
+    }
+    if view_dependent_focus(&results.view_dependent).is_some() {
+        charts.push("view_dependent");
     }
     let images: Vec<String> = charts
         .iter()
@@ -563,6 +568,37 @@ fn render(s: &mut String, results: &Results, b: &Model) {
         let _ = writeln!(s, "\nScene: {} instances of {} models, LoD by screen-space error (1 px) from buffers shared per LoD bucket, culled by the instance BVH, along a fly-through: {:.0} visible, {:.0} triangles ({:.1}% of full detail), update {:.2} ms median ({:.2} ms p99), frame {:.2} ms; {} CPU bytes per instance, GPU {:.2} × the full-detail strips; {} of the covered pixels differ from full detail.", scene.instances, scene.models, scene.visible, scene.triangles_drawn, 100.0 * scene.triangles_drawn / scene.triangles_full_detail.max(1.0), scene.update_ms_median, scene.update_ms_p99, scene.frame_ms_median, scene.cpu_bytes_per_instance, scene.gpu_bytes as f64 / scene.full_detail_strip_bytes.max(1) as f64, scene.differing_pixel_share.map_or("—".into(), |x| format!("{:.3}%", 100.0 * x)));
     }
     let _ = writeln!(s);
+}
+
+/// One paragraph on view-dependent detail: the strip hierarchy against
+/// meshoptimizer's cluster LoD at 1 pixel on the chart's run.
+fn view_dependent(s: &mut String, results: &Results, report_dir: &str) {
+    let Some(run) = view_dependent_focus(&results.view_dependent) else {
+        return;
+    };
+    let row = |method: &str| {
+        run.methods
+            .iter()
+            .find(|r| r.method == method && r.pixel_threshold == 1.0)
+    };
+    let (Some(h), Some(c), Some(m)) = (row("mts_hierarchy"), row("clusterlod"), row("mts")) else {
+        return;
+    };
+    let full = run.triangles_full_detail.max(1) as f64;
+    let _ = writeln!(s, "View-dependent detail ({}, 1 px, {} frames {} it): the strip hierarchy draws {:.0} triangles a frame (median; {:.2}× meshoptimizer's cluster LoD, {:.1}% of full detail, where the per-object model draws {:.1}%) at {:.2} indices a triangle, updates in {:.2} ms median ({:.2} ms p99), with {} cracks and popping of at most {:.2} px; the cluster tree and the other inputs are in [the report]({report_dir}/report.md).\n",
+        run.input,
+        run.frames,
+        if run.flight == "over" { "flying over" } else { "circling" },
+        h.triangles_drawn_median,
+        h.triangles_drawn_median / c.triangles_drawn_median,
+        100.0 * h.triangles_drawn_median / full,
+        100.0 * m.triangles_drawn_median / full,
+        h.indices_per_triangle,
+        h.update_ms_median,
+        h.update_ms_p99,
+        h.cracks,
+        h.popping_px_max,
+    );
 }
 
 /// `readme` with its generated section replaced by `section`; `None`

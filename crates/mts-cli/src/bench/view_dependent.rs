@@ -37,6 +37,7 @@
 //!   ([`mts_render::image_error`]), pooled over those frames.
 
 use crate::args::MeshSource;
+use crate::bench::results::{ViewDependentRow, ViewDependentRun};
 use crate::commands::render::Size;
 use crate::stdout::outln;
 use anyhow::{Context, Result};
@@ -50,7 +51,6 @@ use mts::{Extractor, LodSource};
 use mts_render::headless::HeadlessTarget;
 use mts_render::image_error::{ImageError, ReferenceTarget};
 use mts_render::{Camera, Gpu, RendererConfig, StripRenderer};
-use serde::Serialize;
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -96,51 +96,22 @@ pub struct BenchViewDependentArgs {
     json: bool,
 }
 
-/// What `--json` prints.
-#[derive(Serialize)]
-pub struct ViewDependentReport {
-    pub input: String,
-    pub triangles_full_detail: usize,
-    pub vertices: usize,
-    pub raw_bytes: usize,
-    pub flight: &'static str,
+/// What [`measure`] flies: the input, the thresholds, the flight's frames
+/// and viewport, whether images are compared, the hierarchy's settings.
+pub struct FlightSpec<'a> {
+    pub mesh: &'a Mesh,
+    /// The input's name, as the run reports it.
+    pub name: &'a str,
+    /// The screen-space errors allowed, in pixels: a row per method each.
+    pub pixel_errors: &'a [f32],
+    /// Frames along the flight (at least 2).
     pub frames: usize,
+    /// The viewport the thresholds refer to, in pixels.
     pub width: u32,
     pub height: u32,
-    /// The adapter the images came from; `None` without images.
-    pub adapter: Option<String>,
-    pub methods: Vec<MethodRow>,
-}
-
-/// One method at one pixel threshold along the flight.
-#[derive(Serialize, Clone)]
-pub struct MethodRow {
-    pub method: &'static str,
-    pub pixel_threshold: f64,
-    pub triangles_drawn_median: f64,
-    pub triangles_drawn_max: usize,
-    pub triangles_full_detail: usize,
-    /// Hierarchy only: the median of what frustum culling keeps.
-    pub triangles_visible_median: Option<f64>,
-    /// Indices sent over triangles drawn: the median frame's.
-    pub indices_per_triangle: f64,
-    /// The worst frame's.
-    pub indices_per_triangle_max: f64,
-    pub update_ms_median: f64,
-    pub update_ms_p99: f64,
-    /// Crack edges summed over every frame.
-    pub cracks: usize,
-    pub popping_px_max: f64,
-    pub popping_px_median: f64,
-    pub triangles_changed_median: f64,
-    /// What the method holds in memory to select and extract.
-    pub memory_bytes: usize,
-    pub raw_bytes: usize,
-    /// Vertices plus the largest index buffer of the flight, as uploaded
-    /// (4-byte indices).
-    pub gpu_bytes: usize,
-    pub build_ms: f64,
-    pub image_error_ratio: Option<f64>,
+    /// Compare images with full detail (opens an adapter).
+    pub images: bool,
+    pub options: HierarchyOptions,
 }
 
 /// The eye and the point it looks at, `t` in 0..=1 along the flight over
@@ -315,9 +286,9 @@ fn one_way(
     let mut worst = 0f64;
     for v in left {
         let at = positions[v as usize];
-        if let Some((_, d)) = bvh.closest(at) {
+        if let Some((_, squared)) = bvh.closest(at) {
             let ppu = projection.pixels_per_unit(at.distance(eye));
-            worst = worst.max(f64::from(d) * f64::from(ppu));
+            worst = worst.max(f64::from(squared).sqrt() * f64::from(ppu));
         }
     }
     worst
@@ -490,13 +461,11 @@ struct Built {
     model_ms: f64,
 }
 
-fn build_all(mesh: &Mesh, options: &HierarchyOptions, quiet: bool) -> Result<Built> {
-    let say = |what: &str| -> Result<()> {
-        if !quiet {
-            outln!("building {what}…")?;
-        }
-        Ok(())
-    };
+fn build_all(
+    mesh: &Mesh,
+    options: &HierarchyOptions,
+    say: &dyn Fn(&str) -> Result<()>,
+) -> Result<Built> {
     let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
     say("the strip hierarchy")?;
     let t = Instant::now();
@@ -544,14 +513,14 @@ struct Images {
 }
 
 impl Images {
-    fn new(mesh: &Mesh, lo: Vec3, hi: Vec3, size: &Size) -> Result<Images> {
+    fn new(mesh: &Mesh, lo: Vec3, hi: Vec3, (width, height): (u32, u32)) -> Result<Images> {
         let gpu = Gpu::new_headless()?;
         let config = RendererConfig::headless(gpu.report().strip_mode);
         let (d, q) = (&gpu.device, &gpu.queue);
-        let target = HeadlessTarget::new(d, size.0, size.1)?;
+        let target = HeadlessTarget::new(d, width, height)?;
         let mut full = StripRenderer::new(d, q, &config, &mesh.positions, &mesh.triangles)?;
         full.upload_list(d, q, &mesh.triangles)?;
-        let reference_target = ReferenceTarget::new(d, size.0, size.1)?;
+        let reference_target = ReferenceTarget::new(d, width, height)?;
         let mut frames = Vec::new();
         for k in 0..COMPARED_FRAMES {
             let at = (k as f32 + 0.5) / COMPARED_FRAMES as f32;
@@ -599,34 +568,31 @@ impl Images {
     }
 }
 
-/// Runs the flight for every method and threshold.
+/// Runs the flight for every method and threshold; `say` is told what is
+/// being built.
 ///
 /// # Errors
-/// Loading, building, or the adapter when images are asked for.
+/// Building, an empty mesh or fewer than 2 frames, or the adapter when
+/// images are asked for.
 pub fn measure(
-    mesh: &Mesh,
-    name: &str,
-    args: &BenchViewDependentArgs,
-) -> Result<ViewDependentReport> {
+    spec: &FlightSpec<'_>,
+    say: &dyn Fn(&str) -> Result<()>,
+) -> Result<ViewDependentRun> {
+    let mesh = spec.mesh;
+    anyhow::ensure!(spec.frames >= 2, "a flight needs 2 frames at least");
     let (lo, hi) = mts::mesh::bounds_of(&mesh.positions).context("the mesh has no vertices")?;
-    let mut options = HierarchyOptions {
-        cluster_triangles: args.cluster_triangles,
-        group_clusters: args.group_clusters,
-        ..HierarchyOptions::default()
-    };
-    options.pipeline.build.band_slack = args.band_slack;
-    let built = build_all(mesh, &options, args.json)?;
-    let images = if args.no_images {
-        None
+    let built = build_all(mesh, &spec.options, say)?;
+    let images = if spec.images {
+        Some(Images::new(mesh, lo, hi, (spec.width, spec.height))?)
     } else {
-        Some(Images::new(mesh, lo, hi, &args.size)?)
+        None
     };
     let raw_bytes = built.model.raw_bytes();
-    let (width, height) = (args.size.0, args.size.1);
+    let (width, height) = (spec.width, spec.height);
     let aspect = width as f32 / height as f32;
     let (_, _, terrain) = flight(lo, hi, 0.0);
     let mut rows = Vec::new();
-    for &px in &args.pixel_error {
+    for &px in spec.pixel_errors {
         let centre = 0.5 * (lo + hi);
         let radius = 0.5 * lo.distance(hi);
         let mut methods = vec![
@@ -660,7 +626,7 @@ pub fn measure(
                 _ => mesh.triangles.clone(),
             };
             let boundary = boundary_points(&full, &point);
-            let mut frames = Vec::with_capacity(args.frames);
+            let mut frames = Vec::with_capacity(spec.frames);
             let mut previous: Option<Vec<[u32; 3]>> = None;
             let (mut pops, mut changed) = (Vec::new(), Vec::new());
             let (mut cracked, mut last_cracks, mut buffer_max) = (0usize, 0usize, 0usize);
@@ -668,8 +634,8 @@ pub fn measure(
             // One untimed frame at the start (extractors made, caches warm).
             let (camera, eye) = camera_at(lo, hi, 0.0, aspect);
             method.frame(&camera, eye, height as f32, px);
-            for i in 0..args.frames {
-                let t = i as f32 / (args.frames - 1) as f32;
+            for i in 0..spec.frames {
+                let t = i as f32 / (spec.frames - 1) as f32;
                 let (camera, eye) = camera_at(lo, hi, t, aspect);
                 let frame = method.frame(&camera, eye, height as f32, px);
                 if frame.changed || previous.is_none() {
@@ -719,36 +685,36 @@ pub fn measure(
                     built.model_ms,
                 ),
             };
-            rows.push(MethodRow {
-                method: method.name(),
+            rows.push(ViewDependentRow {
+                method: method.name().to_owned(),
                 pixel_threshold: f64::from(px),
                 triangles_drawn_median: median_p99(drawn.clone()).0,
-                triangles_drawn_max: drawn.iter().copied().fold(0.0, f64::max) as usize,
-                triangles_full_detail: mesh.triangle_count(),
+                triangles_drawn_max: drawn.iter().copied().fold(0.0, f64::max) as u64,
+                triangles_full_detail: mesh.triangle_count() as u64,
                 triangles_visible_median: (!visible.is_empty()).then(|| median_p99(visible).0),
                 indices_per_triangle: median_p99(ipt.clone()).0,
                 indices_per_triangle_max: ipt.iter().copied().fold(0.0, f64::max),
                 update_ms_median,
                 update_ms_p99,
-                cracks: cracked,
+                cracks: cracked as u64,
                 popping_px_max: pops_max,
                 popping_px_median: median_p99(pops).0,
                 triangles_changed_median: median_p99(changed).0,
-                memory_bytes,
-                raw_bytes,
-                gpu_bytes: mts_render::VERTEX_BYTES * positions.len() + 4 * buffer_max,
+                memory_bytes: memory_bytes as u64,
+                raw_bytes: raw_bytes as u64,
+                gpu_bytes: (mts_render::VERTEX_BYTES * positions.len() + 4 * buffer_max) as u64,
                 build_ms,
                 image_error_ratio,
             });
         }
     }
-    Ok(ViewDependentReport {
-        input: name.to_owned(),
-        triangles_full_detail: mesh.triangle_count(),
-        vertices: mesh.vertex_count(),
-        raw_bytes,
-        flight: if terrain { "over" } else { "around" },
-        frames: args.frames,
+    Ok(ViewDependentRun {
+        input: spec.name.to_owned(),
+        triangles_full_detail: mesh.triangle_count() as u64,
+        vertices: mesh.vertex_count() as u64,
+        raw_bytes: raw_bytes as u64,
+        flight: if terrain { "over" } else { "around" }.to_owned(),
+        frames: spec.frames as u64,
         width,
         height,
         adapter: images.as_ref().map(|i| i.gpu.report().name),
@@ -766,7 +732,29 @@ pub fn bench_view_dependent(args: &BenchViewDependentArgs) -> Result<()> {
     } else {
         args.source.load()?
     };
-    let report = measure(&mesh, &name, args)?;
+    let mut options = HierarchyOptions {
+        cluster_triangles: args.cluster_triangles,
+        group_clusters: args.group_clusters,
+        ..HierarchyOptions::default()
+    };
+    options.pipeline.build.band_slack = args.band_slack;
+    let spec = FlightSpec {
+        mesh: &mesh,
+        name: &name,
+        pixel_errors: &args.pixel_error,
+        frames: args.frames,
+        width: args.size.0,
+        height: args.size.1,
+        images: !args.no_images,
+        options,
+    };
+    let say = |what: &str| -> Result<()> {
+        if !args.json {
+            outln!("building {what}…")?;
+        }
+        Ok(())
+    };
+    let report = measure(&spec, &say)?;
     if args.json {
         return outln!("{}", serde_json::to_string(&report)?);
     }

@@ -45,14 +45,15 @@ fn bench_check(args: &CheckArgs) -> Result<()> {
             bad.join("\n  ")
         );
     }
+    let flights = r.view_dependent.len();
     match &r.machine.adapter {
         Some(a) => outln!(
-            "{}: complete ({} models; Figure 6 and the scene on {a})",
+            "{}: complete ({} models, {flights} view-dependent flights; Figure 6, the scene and the flights' images on {a})",
             args.results.display(),
             r.models.len()
         ),
         None => outln!(
-            "{}: complete ({} models; no adapter: {})",
+            "{}: complete ({} models, {flights} view-dependent flights; no adapter: {})",
             args.results.display(),
             r.models.len(),
             r.machine.adapter_note.as_deref().unwrap_or("?")
@@ -130,8 +131,8 @@ pub struct BenchArgs {
     /// Where report.md and results.json go.
     #[arg(long, default_value = "bench-report")]
     pub out: PathBuf,
-    /// The built-in mesh only, fewer requests, no scale section (a smoke
-    /// test of under two minutes).
+    /// The built-in mesh only, fewer requests, no scale section, one small
+    /// view-dependent flight (a smoke test of under two minutes).
     #[arg(long)]
     pub quick: bool,
     /// Skip Figure 6 (frames per second through the headless renderer).

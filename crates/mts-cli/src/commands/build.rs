@@ -21,10 +21,11 @@ pub struct BuildArgs {
     #[arg(long)]
     pub json: bool,
     /// Start a new band of strips when they send this much more indices per
-    /// triangle than at the band's start (see BuildOptions::band_slack).
-    #[arg(allow_negative_numbers = true, long, default_value_t = mts::model::DEFAULT_BAND_SLACK,
-          value_parser = band_slack)]
-    pub band_slack: f64,
+    /// triangle than at the band's start (see BuildOptions::band_slack):
+    /// 0.1 for a model, 0.5 for each group of a hierarchy
+    /// (mts::hierarchy::BAND_SLACK).
+    #[arg(allow_negative_numbers = true, long, value_parser = band_slack)]
+    pub band_slack: Option<f64>,
     /// One band only: the paper's model, whose strips degrade as the mesh
     /// is simplified.
     #[arg(long, conflicts_with = "band_slack")]
@@ -71,8 +72,10 @@ impl BuildArgs {
             build: mts::model::BuildOptions {
                 band_slack: if self.single_band {
                     f64::INFINITY
+                } else if self.hierarchy {
+                    self.band_slack.unwrap_or(mts::hierarchy::BAND_SLACK)
                 } else {
-                    self.band_slack
+                    self.band_slack.unwrap_or(mts::model::DEFAULT_BAND_SLACK)
                 },
                 stripify: StripifyOptions {
                     cache_aware: self.cache_aware,

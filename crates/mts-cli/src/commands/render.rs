@@ -1,17 +1,23 @@
 //! `mts render`: one LoD of a model drawn headless into a PNG, by the MTS
 //! strips or by the oracle triangle list, through `mts_render`; a glTF file
-//! of several parts drawn as a scene of them ([`GltfScene`]).
+//! of several parts drawn as a scene of them ([`GltfScene`]); a
+//! view-dependent hierarchy (a version-4 `.mts` file, or `--hierarchy`:
+//! built from the mesh) drawn as its cut for the camera
+//! ([`mts_render::HierarchyRenderer`]).
 
 use crate::args::{LevelArgs, MeshSource};
+use crate::commands::verify::peek_holds;
 use crate::gltf_scene::GltfScene;
 use crate::stdout::{outln, warnln};
 use anyhow::{bail, Result};
 use clap::builder::TypedValueParser;
 use clap::{Args, ValueEnum};
+use mts::hierarchy::{Hierarchy, HierarchyOptions, ViewDependent};
 use mts::methods::Method;
+use mts::model::format::Holds;
 use mts::{Extractor, MtsModel};
 use mts_render::headless::HeadlessTarget;
-use mts_render::{Camera, Gpu, RendererConfig, StripMode, StripRenderer};
+use mts_render::{Camera, Gpu, HierarchyRenderer, RendererConfig, StripMode, StripRenderer};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -94,8 +100,15 @@ pub struct RenderArgs {
     /// fly). A glTF file of several parts (mesh primitives) is drawn as a
     /// scene: each part with its own texture or material colour, once per
     /// node that holds it, each at the coarsest LoD within --pixel-error.
+    /// A hierarchy's .mts file (`mts build --hierarchy`) is drawn as its
+    /// cut for the camera within --pixel-error.
     #[command(flatten)]
     source: MeshSource,
+    /// Build the view-dependent hierarchy of the mesh (or --generated)
+    /// and draw its cut for the camera, every part within --pixel-error
+    /// (groups simplified where they are far, full detail near).
+    #[arg(long, conflicts_with_all = ["lod", "triangles", "ratio", "scene"])]
+    hierarchy: bool,
     /// The LoD to draw (the full mesh when none is given).
     #[command(flatten)]
     level: LevelArgs,
@@ -131,9 +144,9 @@ pub struct RenderArgs {
     /// in turn with the command's model.
     #[arg(long, value_name = "MESH", num_args = 1.., requires = "scene")]
     scene_with: Vec<PathBuf>,
-    /// In a scene (--scene, or a glTF file of several parts): the
-    /// screen-space error allowed, in pixels (0 draws every instance at
-    /// full detail) [default: 1].
+    /// In a scene (--scene, or a glTF file of several parts) or a
+    /// hierarchy: the screen-space error allowed, in pixels (0 draws every
+    /// instance, or the whole hierarchy, at full detail) [default: 1].
     #[arg(long, allow_hyphen_values = true, value_parser = crate::args::pixel_error)]
     pixel_error: Option<f32>,
 }
@@ -152,6 +165,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     crate::args::check_output(&args.output, &inputs)?;
     let Size(width, height) = args.size;
     let t0 = Instant::now();
+    if let Some((name, h)) = load_hierarchy(&args.source, args.hierarchy)? {
+        let ms_model = t0.elapsed().as_secs_f64() * 1e3;
+        return render_hierarchy(args, &name, &h, ms_model);
+    }
     if let (None, Some(path)) = (args.scene, &args.source.mesh) {
         if let Some(scene) = GltfScene::load_if_several(path, args.source.load_options())? {
             return render_gltf(args, &scene);
@@ -160,7 +177,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.scene.is_none() && args.pixel_error.is_some() {
         bail!(
             "--pixel-error chooses the LoDs of a scene (--scene, or a glTF file of several \
-             parts); one model is drawn at --lod, --triangles or --ratio"
+             parts) or of a hierarchy (--hierarchy); one model is drawn at --lod, --triangles \
+             or --ratio"
         );
     }
     let (name, model) = args.source.model()?;
@@ -257,6 +275,179 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         )?;
     }
     Ok(())
+}
+
+/// The hierarchy a command draws: a version-4 `.mts` file (recognised by
+/// its header, with or without `build`), or with `build` the hierarchy of
+/// the mesh or `--generated` built now with the default options; `None`
+/// otherwise.
+pub(crate) fn load_hierarchy(
+    source: &MeshSource,
+    build: bool,
+) -> Result<Option<(String, Hierarchy)>> {
+    if let Some(path) = &source.mesh {
+        match peek_holds(path) {
+            Some(Holds::Hierarchy) => {
+                let h = Hierarchy::load(path)?;
+                return Ok(Some((path.display().to_string(), h)));
+            }
+            Some(Holds::Model) if build => bail!(
+                "{}: an MTS model's file; --hierarchy builds the hierarchy of a mesh (`mts build \
+                 --hierarchy` writes one to a file)",
+                path.display()
+            ),
+            _ => {}
+        }
+    }
+    if !build {
+        return Ok(None);
+    }
+    let (name, mesh, _) = source.load()?;
+    if mesh.triangle_count() >= HIERARCHY_NOTE_TRIANGLES {
+        warnln!(
+            "{name}: building the hierarchy of {} triangles first (`mts build --hierarchy` \
+             writes it to a file once)",
+            mesh.triangle_count()
+        );
+    }
+    let h = mts::hierarchy::build(&mesh, &HierarchyOptions::default())?;
+    Ok(Some((name, h)))
+}
+
+/// Inputs of this many triangles or more get a note that `--hierarchy`
+/// builds the hierarchy first.
+const HIERARCHY_NOTE_TRIANGLES: usize = 500_000;
+
+/// `mts render` of a hierarchy: its cut for the default camera (as a
+/// model's, framing the input's bounds) within `--pixel-error`, culled to
+/// the view, drawn by the strips of its arena (`--method mts`) or by the
+/// cut's triangles as a list from scratch (`--method list`, the oracle).
+fn render_hierarchy(args: &RenderArgs, name: &str, h: &Hierarchy, ms_model: f64) -> Result<()> {
+    if args.level.lod.is_some() || args.level.triangles.is_some() || args.level.ratio.is_some() {
+        bail!(
+            "{name}: a hierarchy draws every part at the coarsest LoD within --pixel-error; \
+             --lod, --triangles and --ratio choose one model's"
+        );
+    }
+    if args.scene.is_some() {
+        bail!("{name}: a hierarchy is drawn alone; --scene lays out instances of one model");
+    }
+    let list = match args.method {
+        Draw::Method(Method::Mts) => false,
+        Draw::List => true,
+        Draw::Method(m) => bail!(
+            "{name}: a hierarchy is drawn by its strips (--method mts) or its cut's triangle \
+             list (--method list), not by {}",
+            m.name()
+        ),
+    };
+    let Size(width, height) = args.size;
+    let (gpu, report, config, target) = headless(args, width, height)?;
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let appearance = mts_render::Appearance {
+        checker: args.checker,
+    };
+    let mut renderer = HierarchyRenderer::with_appearance(device, queue, &config, h, &appearance)?;
+    for w in renderer.warnings() {
+        warnln!("{w}");
+    }
+    let camera = Camera::framing_points(h.positions(), target.aspect());
+    let pixel_error = args.pixel_threshold();
+    let mut view = ViewDependent::new(h);
+    let t = Instant::now();
+    let frame = renderer.update(
+        device,
+        queue,
+        &mut view,
+        &camera,
+        height as f32,
+        pixel_error,
+        true,
+    )?;
+    let (triangles, indices_sent, upload) = if list {
+        let triangles = view.cut().triangles(h);
+        let upload = renderer
+            .strip_renderer_mut()
+            .upload_list(device, queue, &triangles)?;
+        (triangles.len(), 3 * triangles.len(), upload)
+    } else {
+        (frame.triangles, frame.indices_sent, frame.upload)
+    };
+    let ms_update = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let image = target.render_image(device, queue, |pass| {
+        if list {
+            renderer.strip_renderer().draw(pass);
+        } else {
+            renderer.draw(pass);
+        }
+    })?;
+    let ms_render = t.elapsed().as_secs_f64() * 1e3;
+    image.save_png(&args.output)?;
+    let indices_drawn = if list {
+        renderer.strip_renderer().indices_drawn()
+    } else {
+        frame.indices_drawn
+    };
+    let method = args.method.name();
+    let full = h.triangle_count();
+    if args.json {
+        return outln!(
+            "{}",
+            json!({
+                "input": name,
+                "hierarchy": true,
+                "adapter": report.name,
+                "backend": format!("{:?}", report.backend),
+                "device_type": format!("{:?}", report.device_type),
+                "strip_mode": report.strip_mode.to_string(),
+                "method": method,
+                "pixel_threshold": pixel_error,
+                "levels": h.level_count(),
+                "groups": h.groups().len(),
+                "clusters": h.clusters().len(),
+                "groups_drawn": frame.update.groups_drawn,
+                "clusters_drawn": frame.update.clusters_drawn,
+                "triangles": triangles,
+                "triangles_full_detail": full,
+                "indices_sent": indices_sent,
+                "indices_drawn": indices_drawn,
+                "upload_bytes": upload.bytes,
+                "gpu_bytes": renderer.gpu_bytes(),
+                "cpu_bytes": frame.cpu_bytes,
+                "index_format": format!("{:?}", renderer.index_format()),
+                "foreground_pixels": image.foreground_pixels(),
+                "ms_model": ms_model,
+                "ms_update_upload": ms_update,
+                "ms_render_readback": ms_render,
+                "output": args.output.display().to_string(),
+            })
+        );
+    }
+    print_text(name, &report, &args.output)?;
+    outln!(
+        "  hierarchy {} levels, {} groups, {} clusters; the cut within {pixel_error} px: {} \
+         groups and {} clusters drawn (culled to the view)",
+        h.level_count(),
+        h.groups().len(),
+        h.clusters().len(),
+        frame.update.groups_drawn,
+        frame.update.clusters_drawn
+    )?;
+    outln!(
+        "  drawn     {triangles} triangles of {full} ({:.1}%) by {method}, {indices_sent} indices \
+         sent ({:.2} per triangle), {indices_drawn} drawn as {:?}; GPU {:.1} KB",
+        100.0 * triangles as f64 / full.max(1) as f64,
+        indices_sent as f64 / triangles.max(1) as f64,
+        renderer.index_format(),
+        renderer.gpu_bytes() as f64 / 1e3
+    )?;
+    outln!(
+        "  time      hierarchy (load or build) {ms_model:.1} ms, update+upload {ms_update:.2} ms, render+readback \
+         {ms_render:.1} ms; {} foreground pixels of {}",
+        image.foreground_pixels(),
+        width as usize * height as usize
+    )
 }
 
 fn print_text(name: &str, report: &mts_render::AdapterReport, output: &Path) -> Result<()> {

@@ -1,6 +1,8 @@
 //! `mts view`: a window on a model (orbit camera, LoD by wheel or by
-//! screen-space error), on a scene of instances (`--scene`) or on a glTF
-//! file of several parts; the window itself is [`crate::viewer`].
+//! screen-space error), on a scene of instances (`--scene`), on a glTF
+//! file of several parts, or on a view-dependent hierarchy (a version-4
+//! `.mts` file, or `--hierarchy`: built from the mesh); the window itself
+//! is [`crate::viewer`].
 
 use super::render::MAX_SCENE;
 use crate::args::MeshSource;
@@ -17,9 +19,16 @@ pub struct ViewArgs {
     /// An .mts model, or an OBJ/PLY/glTF mesh (the model is built on the
     /// fly). A glTF file of several parts (mesh primitives) is shown as a
     /// scene: each part with its own texture or material colour, once per
-    /// node that holds it, each at the coarsest LoD within one pixel.
+    /// node that holds it, each at the coarsest LoD within one pixel. A
+    /// hierarchy's .mts file (`mts build --hierarchy`) is shown as its cut
+    /// for the camera, updated every frame.
     #[command(flatten)]
     source: MeshSource,
+    /// Build the view-dependent hierarchy of the mesh (or --generated)
+    /// and show its cut, chosen again every frame for the camera within
+    /// the pixel error (the wheel changes it) and culled to the view.
+    #[arg(long, conflicts_with = "scene")]
+    hierarchy: bool,
     /// Show N instances on a ground plane instead (1000 when N is left
     /// out); `F` flies through them.
     #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "1000",
@@ -41,7 +50,25 @@ pub struct ViewArgs {
 
 /// `mts view`: opens the viewer window.
 pub fn run(args: &ViewArgs) -> Result<()> {
-    use crate::viewer::{run, run_gltf, ViewerContent};
+    use crate::viewer::{run, run_gltf, run_hierarchy, ViewerContent};
+    if let Some((name, h)) = super::render::load_hierarchy(&args.source, args.hierarchy)? {
+        if args.scene.is_some() {
+            anyhow::bail!(
+                "{name}: a hierarchy is shown alone; --scene lays out instances of one model"
+            );
+        }
+        let title = format!("mts view: {name} (hierarchy)");
+        let report = run_hierarchy(&h, args.checker, &title, args.frames)?;
+        return outln!(
+            "{name}: a hierarchy of {} triangles, {} groups: {} frames in {:.1} s on {}; last: {}",
+            h.triangle_count(),
+            h.groups().len(),
+            report.frames,
+            report.seconds,
+            report.adapter,
+            report.last_status
+        );
+    }
     if let (None, Some(path)) = (args.scene, &args.source.mesh) {
         if let Some(scene) = GltfScene::load_if_several(path, args.source.load_options())? {
             let title = format!("mts view: {} ({} parts)", scene.name, scene.part_count);

@@ -41,7 +41,6 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
         .unwrap_or(0);
     let mut h = Hierarchy {
         clusters: Vec::new(),
-        cluster_triangles: Vec::new(),
         groups: Vec::new(),
         positions: mesh.positions.clone(),
         properties: mesh.properties.clone(),
@@ -50,15 +49,21 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
         triangle_count: mesh.triangle_count(),
     };
     let mut current: Vec<u32> = Vec::new();
+    // Every cluster's triangles, while the levels are built; the hierarchy
+    // keeps only their strips.
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
     for part in partition(&mesh.positions, &mesh.triangles, options.cluster_triangles) {
         let tris = part.iter().map(|&t| mesh.triangles[t as usize]);
-        current.push(h.add_cluster(tris, NO_GROUP));
+        current.push(h.add_cluster(&mut triangles, tris, NO_GROUP));
     }
     let mut level = 0u32;
     while !current.is_empty() {
         let slices: Vec<&[[u32; 3]]> = current
             .iter()
-            .map(|&c| h.cluster_triangles(c as usize))
+            .map(|&c| {
+                let r = &h.clusters[c as usize].triangles;
+                &triangles[r.start as usize..r.end as usize]
+            })
             .collect();
         let grouped = group(
             &mesh.positions,
@@ -120,7 +125,7 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
             let mut outputs = Vec::new();
             for part in partition(&mesh.positions, &b.output, options.cluster_triangles) {
                 let tris = part.iter().map(|&t| b.output[t as usize]);
-                outputs.push(h.add_cluster(tris, id));
+                outputs.push(h.add_cluster(&mut triangles, tris, id));
             }
             next.extend_from_slice(&outputs);
             h.groups.push(Group {
@@ -143,7 +148,7 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
         current = next;
         level += 1;
     }
-    super::strips::strip_clusters(&mut h, &options.pipeline.stripify);
+    super::strips::strip_clusters(&mut h, &triangles, &options.pipeline.stripify);
     #[cfg(debug_assertions)]
     if let Err(e) = h.validate() {
         panic!("hierarchy::build made an invalid hierarchy: {e}");
@@ -153,12 +158,18 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
 
 impl Hierarchy {
     /// Appends a cluster of `triangles` made by `producer` (not yet
-    /// consumed) and returns its index.
-    fn add_cluster(&mut self, triangles: impl Iterator<Item = [u32; 3]>, producer: u32) -> u32 {
-        let start = self.cluster_triangles.len() as u32;
-        self.cluster_triangles.extend(triangles);
+    /// consumed), its triangles to `all` (the build's list of every
+    /// cluster's triangles), and returns its index.
+    fn add_cluster(
+        &mut self,
+        all: &mut Vec<[u32; 3]>,
+        triangles: impl Iterator<Item = [u32; 3]>,
+        producer: u32,
+    ) -> u32 {
+        let start = all.len() as u32;
+        all.extend(triangles);
         self.clusters.push(Cluster {
-            triangles: start..self.cluster_triangles.len() as u32,
+            triangles: start..all.len() as u32,
             producer,
             consumer: NO_GROUP,
             strip: 0..0,

@@ -35,7 +35,7 @@ pub fn cracks(h: &Hierarchy, drawn: &[[u32; 3]]) -> usize {
         .iter()
         .enumerate()
         .filter(|(_, c)| c.producer == NO_GROUP)
-        .flat_map(|(i, _)| h.cluster_triangles(i).iter());
+        .flat_map(|(i, _)| h.cluster_triangles(i));
     let mut on_boundary = std::collections::HashSet::new();
     for ((a, b), _) in open_edges(input.map(|t| t.map(point))) {
         on_boundary.insert(a);

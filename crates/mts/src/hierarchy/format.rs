@@ -25,8 +25,6 @@
 //!   of the previous cluster's (zigzag), its triangle count, the same two
 //!   for its strip indices, its producer and its consumer each plus one (0
 //!   for none).
-//! - `CTRI`: the clusters' triangles, each index a zigzag varint of its
-//!   difference from the previous index.
 //! - `CSTR`: the clusters' strips: per index a varint, 0 for a restart,
 //!   otherwise one more than the zigzag of its difference from the
 //!   previous index that is not a restart.
@@ -69,9 +67,7 @@ use std::path::Path;
 /// [`crate::model::format::VERSION`]).
 pub const VERSION: u32 = 4;
 
-const TAGS: [&[u8; 4]; 7] = [
-    b"HIER", b"POSI", b"PROP", b"CLUS", b"CTRI", b"CSTR", b"GRPS",
-];
+const TAGS: [&[u8; 4]; 6] = [b"HIER", b"POSI", b"PROP", b"CLUS", b"CSTR", b"GRPS"];
 /// A group model's sections without its vertices (flag 0), and with them.
 const MODEL_TAGS: [&[u8; 4]; 5] = [b"META", b"STRP", b"STEP", b"CMPN", b"MODL"];
 const OWN_MODEL_TAGS: [&[u8; 4]; 7] = [
@@ -91,7 +87,7 @@ impl Hierarchy {
             self.vertex_count,
             self.triangle_count,
             self.clusters.len(),
-            self.cluster_triangles.len(),
+            self.cluster_triangle_total(),
             self.cluster_strips.len(),
             self.groups.len(),
         ] {
@@ -116,12 +112,6 @@ impl Hierarchy {
             put_varint(&mut clus, plus_one(c.producer));
             put_varint(&mut clus, plus_one(c.consumer));
         }
-        let mut ctri = Vec::new();
-        let mut prev = 0i64;
-        for &v in self.cluster_triangles.iter().flatten() {
-            put_varint(&mut ctri, zigzag(i64::from(v) - prev));
-            prev = i64::from(v);
-        }
         let mut cstr = Vec::new();
         let mut prev = 0i64;
         for &v in &self.cluster_strips {
@@ -143,7 +133,7 @@ impl Hierarchy {
             &mut body,
             TAGS.iter()
                 .copied()
-                .zip([hier, posi, prop, clus, ctri, cstr, grps]),
+                .zip([hier, posi, prop, clus, cstr, grps]),
         );
         seal_body(VERSION, TAGS.len(), &body)
     }
@@ -220,20 +210,19 @@ impl Hierarchy {
         let (_, mut top) = check_header(bytes, file, Holds::Hierarchy, |_| TAGS.len())?;
         let sections = split_sections(&mut top, &TAGS)?;
         top.finish()?;
-        let [mut hier, mut posi, mut prop, mut clus, mut ctri, mut cstr, mut grps]: [Reader; 7] =
-            sections
-                .try_into()
-                .map_err(|_| top.error("section count"))?;
+        let [mut hier, mut posi, mut prop, mut clus, mut cstr, mut grps]: [Reader; 6] = sections
+            .try_into()
+            .map_err(|_| top.error("section count"))?;
 
         // HIER: counts, each bounded by the bytes of the section that holds it.
         let vertices = hier.count(
             "vertex count",
             ((posi.remaining() / 12) as u64).min(u64::from(u32::MAX)),
         )?;
-        let triangles = hier.count("triangle count", (ctri.remaining() / 3) as u64)?;
+        // A strip of n indices draws at most n triangles.
+        let triangles = hier.count("triangle count", cstr.remaining() as u64)?;
         let cluster_count = hier.count("cluster count", (clus.remaining() / 6) as u64)?;
-        let cluster_triangles =
-            hier.count("cluster triangle count", (ctri.remaining() / 3) as u64)?;
+        let cluster_triangles = hier.count("cluster triangle count", cstr.remaining() as u64)?;
         let strip_indices = hier.count("cluster strip index count", cstr.remaining() as u64)?;
         let group_count = hier.count(
             "group count",
@@ -298,26 +287,6 @@ impl Hierarchy {
         }
         clus.finish()?;
 
-        // CTRI.
-        let mut tris = Vec::with_capacity(cluster_triangles);
-        let mut prev = 0i64;
-        for t in 0..cluster_triangles {
-            let mut tri = [0u32; 3];
-            for x in &mut tri {
-                let at = ctri.pos;
-                let v = prev + unzigzag(ctri.varint()?);
-                if v < 0 || v >= vertices as i64 {
-                    ctri.pos = at;
-                    return Err(ctri.error(format!(
-                        "cluster triangle {t}: vertex {v}, vertices are 0..{vertices}"
-                    )));
-                }
-                *x = v as u32;
-                prev = v;
-            }
-            tris.push(tri);
-        }
-        ctri.finish()?;
         let input_triangles: usize = clusters
             .iter()
             .filter(|c| c.producer == NO_GROUP)
@@ -353,6 +322,27 @@ impl Hierarchy {
             prev = v;
         }
         cstr.finish()?;
+        // The clusters' triangles, decoded from their strips for the
+        // checks below (not kept: the strips are what is drawn).
+        let mut tris = Vec::with_capacity(cluster_triangles);
+        for (i, c) in clusters.iter().enumerate() {
+            let strip = &strips[c.strip.start as usize..c.strip.end as usize];
+            let drawn = super::strips::triangles_of(strip);
+            if drawn.len() != c.triangles.len() || c.triangles.start as usize != tris.len() {
+                return Err(parse_error(
+                    file,
+                    clus.base,
+                    "CLUS",
+                    format!(
+                        "cluster {i}: its strips draw {} triangles, it says {:?} (after {})",
+                        drawn.len(),
+                        c.triangles,
+                        tris.len()
+                    ),
+                ));
+            }
+            tris.extend(drawn);
+        }
 
         // GRPS: cut into groups here, decoded on all cores.
         let mut records = Vec::with_capacity(group_count);
@@ -394,9 +384,9 @@ impl Hierarchy {
             ));
         }
 
+        drop(tris);
         let h = Hierarchy {
             clusters,
-            cluster_triangles: tris,
             groups,
             positions,
             properties,

@@ -53,6 +53,17 @@ use glam::Vec3;
 /// border are grouped again with others on the next level).
 pub const STUCK_RATIO: f64 = 0.85;
 
+/// The band slack of the groups' models (the per-object model's is
+/// [`crate::model::DEFAULT_BAND_SLACK`], 0.1).
+///
+/// **Decision: 0.5, half the memory for 8% more indices.** A group halves
+/// its triangles, so its bands are few and short-lived, and at 0.1 they
+/// made the hierarchy 8.25 × the raw mesh on `terrain:100k` for 1.43
+/// indices a triangle over 30 frames of the bench's flight at 1 px; at 0.5
+/// it is 5.0 × for 1.54; at 1.0 4.5 × for 1.61; one band 3.9 × for 1.61
+/// (`docs/experiments/hierarchy.md`, "Bands").
+pub const BAND_SLACK: f64 = 0.5;
+
 /// "No group" in [`Cluster::producer`] and [`Cluster::consumer`].
 pub const NO_GROUP: u32 = u32::MAX;
 
@@ -68,7 +79,7 @@ pub struct HierarchyOptions {
     pub group_clusters: usize,
     /// Each group's strips, their bands and the contraction sequence's
     /// settings (its `stop_at_triangles` is set per group, to half its
-    /// input).
+    /// input; the default band slack is [`BAND_SLACK`]).
     pub pipeline: crate::model::PipelineOptions,
 }
 
@@ -77,7 +88,13 @@ impl Default for HierarchyOptions {
         HierarchyOptions {
             cluster_triangles: 128,
             group_clusters: 4,
-            pipeline: crate::model::PipelineOptions::default(),
+            pipeline: crate::model::PipelineOptions {
+                build: crate::model::BuildOptions {
+                    band_slack: BAND_SLACK,
+                    ..crate::model::BuildOptions::default()
+                },
+                ..crate::model::PipelineOptions::default()
+            },
         }
     }
 }
@@ -86,7 +103,9 @@ impl Default for HierarchyOptions {
 /// or of one group's output.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cluster {
-    /// Its triangles in [`Hierarchy::cluster_triangles`].
+    /// Its triangles' numbers: clusters number their triangles one after
+    /// the other, so `triangles.len()` is its triangle count (the
+    /// triangles themselves are its strips', [`Hierarchy::cluster_triangles`]).
     pub triangles: std::ops::Range<u32>,
     /// The group whose output it is; [`NO_GROUP`] for a cluster of the
     /// input.
@@ -166,7 +185,6 @@ impl Group {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Hierarchy {
     pub(crate) clusters: Vec<Cluster>,
-    pub(crate) cluster_triangles: Vec<[u32; 3]>,
     pub(crate) groups: Vec<Group>,
     /// The input's vertices: what every cut indexes (one vertex buffer).
     pub(crate) positions: Vec<Vec3>,
@@ -191,11 +209,23 @@ impl Hierarchy {
         &self.clusters
     }
 
-    /// The triangles of cluster `c`, in input vertex numbers.
+    /// The triangles of cluster `c`, in input vertex numbers, decoded from
+    /// its strips (only the strips are kept). O(its strips).
     #[must_use]
-    pub fn cluster_triangles(&self, c: usize) -> &[[u32; 3]] {
-        let r = &self.clusters[c].triangles;
-        &self.cluster_triangles[r.start as usize..r.end as usize]
+    pub fn cluster_triangles(&self, c: usize) -> Vec<[u32; 3]> {
+        strips::triangles_of(self.cluster_strip(c))
+    }
+
+    /// The number of triangles of cluster `c`. O(1).
+    #[must_use]
+    pub fn cluster_triangle_count(&self, c: usize) -> usize {
+        self.clusters[c].triangles.len()
+    }
+
+    /// Triangles of every cluster of every level.
+    #[must_use]
+    pub fn cluster_triangle_total(&self) -> usize {
+        self.clusters.last().map_or(0, |c| c.triangles.end as usize)
     }
 
     /// The strips of cluster `c`: runs in input vertex numbers separated by
@@ -252,7 +282,6 @@ impl Hierarchy {
             })
             .sum();
         groups
-            + 12 * self.cluster_triangles.len()
             + 4 * self.cluster_strips.len()
             + std::mem::size_of::<Cluster>() * self.clusters.len()
             + (12 + self.properties.bytes_per_vertex()) * self.positions.len()
@@ -273,27 +302,30 @@ impl Hierarchy {
             "{nv} positions for {} vertices",
             self.vertex_count
         );
+        let mut next_triangle = 0u32;
         for (i, c) in self.clusters.iter().enumerate() {
-            let ok = c.triangles.start <= c.triangles.end
-                && c.triangles.end as usize <= self.cluster_triangles.len();
-            ensure!(S, ok, "cluster {i}: triangles out of range");
+            ensure!(
+                S,
+                c.triangles.start == next_triangle && c.triangles.start <= c.triangles.end,
+                "cluster {i}: triangles {:?} do not follow the previous cluster's",
+                c.triangles
+            );
+            next_triangle = c.triangles.end;
             let ok =
                 c.strip.start <= c.strip.end && c.strip.end as usize <= self.cluster_strips.len();
             ensure!(S, ok, "cluster {i}: strips out of range");
-            let triangles = self.cluster_triangles(i);
-            let in_range = triangles.iter().flatten().all(|&v| (v as usize) < nv);
-            ensure!(S, in_range, "cluster {i}: a vertex out of range");
             let strip = self.cluster_strip(i);
             let in_range = strip
                 .iter()
                 .all(|&v| v == crate::strip::encode::RESTART_U32 || (v as usize) < nv);
             ensure!(S, in_range, "cluster {i}: a strip vertex out of range");
-            let drawn = crate::strip::sorted_canonical(&strips::triangles_of(strip));
-            let own = crate::strip::sorted_canonical(triangles);
+            let drawn = strips::triangles_of(strip);
             ensure!(
                 S,
-                drawn == own,
-                "cluster {i}: its strips do not draw its triangles"
+                drawn.len() == c.triangles.len(),
+                "cluster {i}: its strips draw {} triangles, it has {}",
+                drawn.len(),
+                c.triangles.len()
             );
             for (end, name) in [(c.producer, "producer"), (c.consumer, "consumer")] {
                 ensure!(
@@ -376,7 +408,7 @@ impl Hierarchy {
             let inputs: usize = g
                 .inputs
                 .iter()
-                .map(|&c| self.cluster_triangles(c as usize).len())
+                .map(|&c| self.cluster_triangle_count(c as usize))
                 .sum();
             let lod0 = g.model.triangle_count(0);
             ensure!(

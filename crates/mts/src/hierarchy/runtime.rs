@@ -334,7 +334,7 @@ impl<'h> ViewDependent<'h> {
         }
         for &c in &self.drawn_clusters {
             indices += h.cluster_strip(c as usize).len();
-            triangles += h.cluster_triangles(c as usize).len();
+            triangles += h.cluster_triangle_count(c as usize);
         }
         self.indices_sent = indices;
         self.triangles = triangles;
@@ -356,7 +356,9 @@ impl<'h> ViewDependent<'h> {
             &extractor.buffer()[active.clone()],
             &group.vertices,
         );
-        self.dirty.push(start..start + len);
+        // The separating restart too: a GPU buffer may hold anything there
+        // after the arena shrank and grew again.
+        self.dirty.push(start..start + len + 1);
         self.group_slot[g as usize] = start as u32;
         self.group_lod[g as usize] = lod;
         walked
@@ -397,7 +399,7 @@ impl<'h> ViewDependent<'h> {
         let strip = self.h.cluster_strip(c as usize);
         let start = self.allocate(strip.len() + 1);
         self.buffer[start..start + strip.len()].copy_from_slice(strip);
-        self.dirty.push(start..start + strip.len());
+        self.dirty.push(start..start + strip.len() + 1);
         self.cluster_slot[c as usize] = start as u32;
     }
 

@@ -68,7 +68,7 @@ impl Cut {
             out.extend(h.groups[g as usize].triangles_at(lod as usize));
         }
         for &c in &self.clusters {
-            out.extend_from_slice(h.cluster_triangles(c as usize));
+            out.extend(h.cluster_triangles(c as usize));
         }
         out
     }
@@ -84,7 +84,7 @@ impl Cut {
         let clusters: usize = self
             .clusters
             .iter()
-            .map(|&c| h.cluster_triangles(c as usize).len())
+            .map(|&c| h.cluster_triangle_count(c as usize))
             .sum();
         groups + clusters
     }

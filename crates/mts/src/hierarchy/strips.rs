@@ -59,9 +59,9 @@ fn strip_cluster(
     }
 }
 
-/// Fills `h.cluster_strips` and every cluster's `strip` range, on all
-/// cores.
-pub(super) fn strip_clusters(h: &mut Hierarchy, options: &StripifyOptions) {
+/// Fills `h.cluster_strips` and every cluster's `strip` range from
+/// `triangles` (every cluster's, by its `triangles` range), on all cores.
+pub(super) fn strip_clusters(h: &mut Hierarchy, triangles: &[[u32; 3]], options: &StripifyOptions) {
     let n = h.clusters.len();
     let chunks = n.div_ceil(CHUNK);
     let threads = std::thread::available_parallelism()
@@ -83,7 +83,8 @@ pub(super) fn strip_clusters(h: &mut Hierarchy, options: &StripifyOptions) {
                         }
                         let (mut indices, mut ends) = (Vec::new(), Vec::new());
                         for c in chunk * CHUNK..((chunk + 1) * CHUNK).min(n) {
-                            let tris = hr.cluster_triangles(c);
+                            let r = &hr.clusters[c].triangles;
+                            let tris = &triangles[r.start as usize..r.end as usize];
                             strip_cluster(&hr.positions, tris, options, &mut remap, &mut indices);
                             ends.push(indices.len() as u32);
                         }
