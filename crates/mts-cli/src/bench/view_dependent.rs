@@ -153,9 +153,46 @@ fn camera_at(lo: Vec3, hi: Vec3, t: f32, aspect: f32) -> (Camera, Vec3) {
     )
 }
 
+/// FxHash's multiply-and-rotate: the edge maps take millions of keys a
+/// frame on the large inputs, where SipHash's resistance to chosen keys
+/// buys nothing and costs most of the time.
+#[derive(Default, Clone, Copy)]
+struct FastHasher(u64);
+
+impl FastHasher {
+    fn add(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+impl std::hash::Hasher for FastHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.add(u64::from_le_bytes(word));
+        }
+    }
+
+    fn write_u32(&mut self, x: u32) {
+        self.add(u64::from(x));
+    }
+
+    fn write_u64(&mut self, x: u64) {
+        self.add(x);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+type FastMap<K, V> = HashMap<K, V, std::hash::BuildHasherDefault<FastHasher>>;
+
 /// Points of `positions` (vertices at one position are one point).
 fn points_of(positions: &[Vec3]) -> Vec<u32> {
-    let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
+    let mut first: FastMap<[u32; 3], u32> =
+        FastMap::with_capacity_and_hasher(positions.len(), Default::default());
     positions
         .iter()
         .enumerate()
@@ -167,58 +204,98 @@ fn points_of(positions: &[Vec3]) -> Vec<u32> {
         .collect()
 }
 
-/// Crack edges of `drawn` (see the module documentation): `point` maps a
-/// vertex to its point, `boundary` flags the input's boundary points.
-fn cracks(drawn: &[[u32; 3]], point: &[u32], boundary: &[bool]) -> usize {
-    let mut balance: HashMap<(u32, u32), i32> = HashMap::new();
-    for t in drawn {
+/// The edge `a -> b` between points: its key (the smaller point first)
+/// and its direction (+1 from the smaller).
+fn edge_key(a: u32, b: u32) -> (u64, i32) {
+    if a < b {
+        ((u64::from(a) << 32) | u64::from(b), 1)
+    } else {
+        ((u64::from(b) << 32) | u64::from(a), -1)
+    }
+}
+
+/// The points of an edge key.
+fn edge_points(key: u64) -> (usize, usize) {
+    ((key >> 32) as usize, (key & 0xffff_ffff) as usize)
+}
+
+/// The crack edges of the triangles drawn (see the module documentation),
+/// kept as triangles come and go: per edge taken by point, the times it
+/// is drawn in one direction less the other, and how many such balances
+/// are not zero away from the input's boundary. A frame's count costs its
+/// changed triangles, not all it draws.
+struct Cracks<'p> {
+    /// A vertex's point, and the input's boundary points.
+    point: &'p [u32],
+    boundary: &'p [bool],
+    balance: FastMap<u64, i32>,
+    count: usize,
+}
+
+impl<'p> Cracks<'p> {
+    fn new(point: &'p [u32], boundary: &'p [bool]) -> Cracks<'p> {
+        Cracks {
+            point,
+            boundary,
+            balance: FastMap::default(),
+            count: 0,
+        }
+    }
+
+    /// Counts `t` drawn once more (`sign` 1) or once less (-1).
+    fn add(&mut self, t: &[u32; 3], sign: i32) {
         for i in 0..3 {
-            let (a, b) = (point[t[i] as usize], point[t[(i + 1) % 3] as usize]);
+            let (a, b) = (
+                self.point[t[i] as usize],
+                self.point[t[(i + 1) % 3] as usize],
+            );
             if a == b {
                 continue;
             }
-            let (key, d) = if a < b { ((a, b), 1) } else { ((b, a), -1) };
-            *balance.entry(key).or_insert(0) += d;
+            let (key, d) = edge_key(a, b);
+            let balance = self.balance.entry(key).or_insert(0);
+            let old = *balance;
+            *balance += sign * d;
+            let (p, q) = edge_points(key);
+            if self.boundary[p] && self.boundary[q] {
+                continue;
+            }
+            match (old != 0, *balance != 0) {
+                (false, true) => self.count += 1,
+                (true, false) => self.count -= 1,
+                _ => {}
+            }
         }
     }
-    balance
-        .iter()
-        .filter(|&(&(a, b), &d)| d != 0 && !(boundary[a as usize] && boundary[b as usize]))
-        .count()
 }
 
 /// The input's boundary points: ends of edges (by point) not paired.
 fn boundary_points(triangles: &[[u32; 3]], point: &[u32]) -> Vec<bool> {
-    let mut balance: HashMap<(u32, u32), i32> = HashMap::new();
+    let mut balance: FastMap<u64, i32> = FastMap::default();
     for t in triangles {
         for i in 0..3 {
             let (a, b) = (point[t[i] as usize], point[t[(i + 1) % 3] as usize]);
             if a != b {
-                let (key, d) = if a < b { ((a, b), 1) } else { ((b, a), -1) };
+                let (key, d) = edge_key(a, b);
                 *balance.entry(key).or_insert(0) += d;
             }
         }
     }
     let mut out = vec![false; point.len()];
-    for (&(a, b), &d) in &balance {
+    for (&key, &d) in &balance {
         if d != 0 {
-            out[a as usize] = true;
-            out[b as usize] = true;
+            let (a, b) = edge_points(key);
+            out[a] = true;
+            out[b] = true;
         }
     }
     out
 }
 
-/// Popping between two frames' triangles (sorted canonically), in pixels,
-/// and the triangles that changed (see the module documentation).
-fn popping(
-    before: &[[u32; 3]],
-    after: &[[u32; 3]],
-    positions: &[Vec3],
-    point: &[u32],
-    eye: Vec3,
-    projection: &Projection,
-) -> (f64, usize) {
+/// Walks two frames' triangles (sorted canonically) together, telling
+/// `f` each triangle gone (-1) and come (+1); returns the larger of the
+/// two counts, the triangles that changed.
+fn diff(before: &[[u32; 3]], after: &[[u32; 3]], mut f: impl FnMut(&[u32; 3], i32)) -> usize {
     let (mut gone, mut came) = (0usize, 0usize);
     let (mut i, mut j) = (0, 0);
     while i < before.len() || j < after.len() {
@@ -228,39 +305,50 @@ fn popping(
                 j += 1;
             }
             (Some(a), Some(b)) if a < b => {
+                f(a, -1);
                 gone += 1;
                 i += 1;
             }
-            (Some(_), None) => {
+            (Some(a), None) => {
+                f(a, -1);
                 gone += 1;
                 i += 1;
             }
-            (_, Some(_)) => {
+            (_, Some(b)) => {
+                f(b, 1);
                 came += 1;
                 j += 1;
             }
             (None, None) => break,
         }
     }
-    let worst = one_way(before, after, positions, point, eye, projection)
-        .max(one_way(after, before, positions, point, eye, projection));
-    (worst, gone.max(came))
+    gone.max(came)
+}
+
+/// A frame's triangles (sorted canonically) and, once one direction of
+/// [`one_way`] needed it, the BVH of their surface, kept for the next
+/// frame's other direction.
+struct Drawn {
+    sorted: Vec<[u32; 3]>,
+    bvh: Option<mts::distance::bvh::TriangleBvh>,
 }
 
 /// The largest distance in pixels from a point that `from` draws and `to`
-/// does not to the surface `to` draws. The whole surface: a vertex may
-/// leave with its whole fan (a sliver that degenerates), and then nothing
-/// replaces it but the surface around.
+/// does not to the surface `to` draws (its BVH built into `to.bvh` when
+/// first needed). The whole surface: a vertex may leave with its whole
+/// fan (a sliver that degenerates), and then nothing replaces it but the
+/// surface around. Popping between two frames is the larger of both
+/// directions.
 fn one_way(
     from: &[[u32; 3]],
-    to: &[[u32; 3]],
+    to: &mut Drawn,
     positions: &[Vec3],
     point: &[u32],
     eye: Vec3,
     projection: &Projection,
 ) -> f64 {
     let mut used = vec![false; positions.len()];
-    for t in to {
+    for t in &to.sorted {
         for &v in t {
             used[point[v as usize] as usize] = true;
         }
@@ -275,14 +363,17 @@ fn one_way(
             }
         }
     }
-    if left.is_empty() || to.is_empty() {
+    if left.is_empty() || to.sorted.is_empty() {
         return 0.0;
     }
-    let bvh = mts::distance::bvh::TriangleBvh::new(
-        to.iter()
-            .map(|t| t.map(|v| positions[v as usize]))
-            .collect(),
-    );
+    let bvh = to.bvh.get_or_insert_with(|| {
+        mts::distance::bvh::TriangleBvh::new(
+            to.sorted
+                .iter()
+                .map(|t| t.map(|v| positions[v as usize]))
+                .collect(),
+        )
+    });
     let mut worst = 0f64;
     for v in left {
         let at = positions[v as usize];
@@ -626,8 +717,9 @@ pub fn measure(
                 _ => mesh.triangles.clone(),
             };
             let boundary = boundary_points(&full, &point);
+            let mut cracks = Cracks::new(&point, &boundary);
             let mut frames = Vec::with_capacity(spec.frames);
-            let mut previous: Option<Vec<[u32; 3]>> = None;
+            let mut previous: Option<Drawn> = None;
             let (mut pops, mut changed) = (Vec::new(), Vec::new());
             let (mut cracked, mut last_cracks, mut buffer_max) = (0usize, 0usize, 0usize);
             let (mut drawn, mut visible, mut ipt) = (Vec::new(), Vec::new(), Vec::new());
@@ -639,16 +731,40 @@ pub fn measure(
                 let (camera, eye) = camera_at(lo, hi, t, aspect);
                 let frame = method.frame(&camera, eye, height as f32, px);
                 if frame.changed || previous.is_none() {
-                    last_cracks = cracks(&frame.triangles, &point, &boundary);
-                    let sorted = mts::strip::sorted_canonical(&frame.triangles);
-                    if let Some(before) = &previous {
+                    let mut now = Drawn {
+                        sorted: mts::strip::sorted_canonical(&frame.triangles),
+                        bvh: None,
+                    };
+                    if let Some(mut before) = previous.take() {
+                        let change = diff(&before.sorted, &now.sorted, |t, sign| {
+                            cracks.add(t, sign);
+                        });
                         let projection = camera.projection(height as f32);
-                        let (pop, change) =
-                            popping(before, &sorted, &positions, &point, eye, &projection);
+                        let pop = one_way(
+                            &before.sorted,
+                            &mut now,
+                            &positions,
+                            &point,
+                            eye,
+                            &projection,
+                        )
+                        .max(one_way(
+                            &now.sorted,
+                            &mut before,
+                            &positions,
+                            &point,
+                            eye,
+                            &projection,
+                        ));
                         pops.push(pop);
                         changed.push(change as f64);
+                    } else {
+                        for t in &now.sorted {
+                            cracks.add(t, 1);
+                        }
                     }
-                    previous = Some(sorted);
+                    last_cracks = cracks.count;
+                    previous = Some(now);
                 } else if previous.is_some() {
                     pops.push(0.0);
                     changed.push(0.0);
