@@ -236,23 +236,7 @@ fn build_group(
     options: &HierarchyOptions,
     remap: &mut [u32],
 ) -> Built {
-    let mut vertices = Vec::new();
-    let local: Vec<[u32; 3]> = triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                let r = &mut remap[v as usize];
-                if *r == u32::MAX {
-                    *r = vertices.len() as u32;
-                    vertices.push(v);
-                }
-                *r
-            })
-        })
-        .collect();
-    for &v in &vertices {
-        remap[v as usize] = u32::MAX;
-    }
+    let (vertices, local) = super::strips::renumber(triangles, remap);
     let properties = if mesh.properties.is_empty() {
         Properties::default()
     } else {

@@ -28,23 +28,7 @@ fn strip_cluster(
     remap: &mut [u32],
     out: &mut Vec<u32>,
 ) {
-    let mut vertices: Vec<u32> = Vec::new();
-    let local: Vec<[u32; 3]> = triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                let r = &mut remap[v as usize];
-                if *r == u32::MAX {
-                    *r = vertices.len() as u32;
-                    vertices.push(v);
-                }
-                *r
-            })
-        })
-        .collect();
-    for &v in &vertices {
-        remap[v as usize] = u32::MAX;
-    }
+    let (vertices, local) = renumber(triangles, remap);
     let submesh = Mesh {
         positions: vertices.iter().map(|&v| positions[v as usize]).collect(),
         triangles: local,
@@ -113,6 +97,31 @@ pub(super) fn strip_clusters(h: &mut Hierarchy, triangles: &[[u32; 3]], options:
         all.extend(indices);
     }
     h.cluster_strips = all;
+}
+
+/// `triangles` renumbered from 0 in order of first use: the vertices used
+/// (`vertices[i]` is local vertex `i`) and the local triangles. `remap` is
+/// all `u32::MAX` on entry and on return (one per input vertex). The
+/// submesh of a cluster here and of a group in `build.rs`.
+pub(super) fn renumber(triangles: &[[u32; 3]], remap: &mut [u32]) -> (Vec<u32>, Vec<[u32; 3]>) {
+    let mut vertices: Vec<u32> = Vec::new();
+    let local: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                let r = &mut remap[v as usize];
+                if *r == u32::MAX {
+                    *r = vertices.len() as u32;
+                    vertices.push(v);
+                }
+                *r
+            })
+        })
+        .collect();
+    for &v in &vertices {
+        remap[v as usize] = u32::MAX;
+    }
+    (vertices, local)
 }
 
 /// The triangles that `strip` (runs separated by [`RESTART`]) draws.
