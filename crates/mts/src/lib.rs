@@ -43,6 +43,7 @@ pub mod mesh;
 pub mod methods;
 pub mod model;
 pub mod output;
+mod parallel;
 #[cfg(feature = "peers")]
 pub mod peers;
 pub mod screen_error;

@@ -11,7 +11,6 @@ use crate::model::MtsModel;
 use crate::simplify::{simplify_locked, Placement};
 use crate::strip::stripify;
 use glam::Vec3;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Builds the hierarchy of `mesh` (see the module documentation of
 /// [`super`]): groups of each level built in parallel on all cores.
@@ -196,33 +195,11 @@ fn build_groups(
     shared: &[bool],
     options: &HierarchyOptions,
 ) -> Vec<Built> {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, std::num::NonZeroUsize::get)
-        .min(inputs.len())
-        .max(1);
-    let next = AtomicUsize::new(0);
-    let mut done: Vec<(usize, Built)> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut remap = vec![u32::MAX; mesh.vertex_count()];
-                    let mut out = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, Ordering::Relaxed);
-                        let Some(tris) = inputs.get(i) else { break };
-                        out.push((i, build_group(mesh, tris, shared, options, &mut remap)));
-                    }
-                    out
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    });
-    done.sort_unstable_by_key(|(i, _)| *i);
-    done.into_iter().map(|(_, b)| b).collect()
+    crate::parallel::map_indexed(
+        inputs.len(),
+        || vec![u32::MAX; mesh.vertex_count()],
+        |remap, i| build_group(mesh, &inputs[i], shared, options, remap),
+    )
 }
 
 /// One group: its submesh (input vertices and properties, no texture: the

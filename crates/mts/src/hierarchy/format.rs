@@ -428,36 +428,13 @@ struct Context<'a> {
 /// Decodes every group's record on all cores; the first error in group
 /// order (whichever thread met it) is the one returned.
 fn decode_groups(records: Vec<Reader<'_>>, context: &Context<'_>) -> Result<Vec<Group>> {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    let n = records.len();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, std::num::NonZeroUsize::get)
-        .min(n)
-        .max(1);
-    let next = AtomicUsize::new(0);
-    let records = &records;
-    let mut done: Vec<(usize, Result<Group>)> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut out = Vec::new();
-                    loop {
-                        let g = next.fetch_add(1, Ordering::Relaxed);
-                        let Some(r) = records.get(g) else { break };
-                        let group = decode_group(r.clone(), g, context).map_err(|e| in_group(e, g));
-                        out.push((g, group));
-                    }
-                    out
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    });
-    done.sort_unstable_by_key(|(g, _)| *g);
-    done.into_iter().map(|(_, g)| g).collect()
+    crate::parallel::map_indexed(
+        records.len(),
+        || (),
+        |(), g| decode_group(records[g].clone(), g, context).map_err(|e| in_group(e, g)),
+    )
+    .into_iter()
+    .collect()
 }
 
 /// Group `g`'s record.

@@ -13,7 +13,6 @@ use crate::mesh::Mesh;
 use crate::strip::encode::RESTART_U32 as RESTART;
 use crate::strip::{stripify, StripifyOptions};
 use glam::Vec3;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Clusters stripified per task of the worker threads.
 const CHUNK: usize = 64;
@@ -47,46 +46,24 @@ fn strip_cluster(
 /// `triangles` (every cluster's, by its `triangles` range), on all cores.
 pub(super) fn strip_clusters(h: &mut Hierarchy, triangles: &[[u32; 3]], options: &StripifyOptions) {
     let n = h.clusters.len();
-    let chunks = n.div_ceil(CHUNK);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, std::num::NonZeroUsize::get)
-        .min(chunks)
-        .max(1);
-    let next = AtomicUsize::new(0);
     let hr: &Hierarchy = h;
-    let mut done: Vec<(usize, Vec<u32>, Vec<u32>)> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut remap = vec![u32::MAX; hr.positions.len()];
-                    let mut out = Vec::new();
-                    loop {
-                        let chunk = next.fetch_add(1, Ordering::Relaxed);
-                        if chunk >= chunks {
-                            break;
-                        }
-                        let (mut indices, mut ends) = (Vec::new(), Vec::new());
-                        for c in chunk * CHUNK..((chunk + 1) * CHUNK).min(n) {
-                            let r = &hr.clusters[c].triangles;
-                            let tris = &triangles[r.start as usize..r.end as usize];
-                            strip_cluster(&hr.positions, tris, options, &mut remap, &mut indices);
-                            ends.push(indices.len() as u32);
-                        }
-                        out.push((chunk, indices, ends));
-                    }
-                    out
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    });
-    done.sort_unstable_by_key(|(chunk, _, _)| *chunk);
+    let done: Vec<(Vec<u32>, Vec<u32>)> = crate::parallel::map_indexed(
+        n.div_ceil(CHUNK),
+        || vec![u32::MAX; hr.positions.len()],
+        |remap, chunk| {
+            let (mut indices, mut ends) = (Vec::new(), Vec::new());
+            for c in chunk * CHUNK..((chunk + 1) * CHUNK).min(n) {
+                let r = &hr.clusters[c].triangles;
+                let tris = &triangles[r.start as usize..r.end as usize];
+                strip_cluster(&hr.positions, tris, options, remap, &mut indices);
+                ends.push(indices.len() as u32);
+            }
+            (indices, ends)
+        },
+    );
     let mut all = Vec::new();
     let mut c = 0;
-    for (_, indices, ends) in done {
+    for (indices, ends) in done {
         let base = all.len() as u32;
         let mut start = base;
         for end in ends {
