@@ -268,3 +268,51 @@ fn bench_view_dependent_compares_the_four_methods() {
         }
     }
 }
+
+/// `mts bench render --hierarchy --json`: the hierarchy's strips and the
+/// same cut as a list over the flight, the strips sending fewer indices
+/// for the same triangles, the list 3 a triangle, a camera step timed for
+/// the strips only. Without an adapter the command says so (an error
+/// unless `MTS_REQUIRE` names gpu, as in CI).
+#[test]
+fn bench_render_draws_a_hierarchy_along_the_flight() {
+    let (ok, out, err) = mts(&[
+        "bench",
+        "render",
+        "--generated",
+        "terrain:20k",
+        "--hierarchy",
+        "--frames",
+        "5",
+        "--size",
+        "160x90",
+        "--json",
+    ]);
+    let gpu_required = std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w == "gpu"));
+    if !ok && !gpu_required && err.contains("adapter") {
+        eprintln!("skipped: no graphics adapter ({err})");
+        return;
+    }
+    assert!(ok, "{err}");
+    let r = json(&out);
+    assert_eq!(r["hierarchy"], true);
+    assert_eq!(r["cameras"], 5);
+    assert_eq!(r["triangles_full_detail"], 20_000);
+    let rows = r["rows"].as_array().unwrap();
+    let methods: Vec<_> = rows.iter().map(|m| m["method"].as_str().unwrap()).collect();
+    assert_eq!(methods, ["mts_hierarchy", "meshopt"]);
+    let (strips, list) = (&rows[0], &rows[1]);
+    let triangles = strips["triangles_median"].as_u64().unwrap();
+    assert!(triangles > 0 && triangles < 20_000, "{r}");
+    assert_eq!(list["triangles_median"], triangles);
+    assert_eq!(list["indices_sent_median"].as_u64(), Some(3 * triangles));
+    let sent = strips["indices_sent_median"].as_u64().unwrap();
+    assert!(sent > triangles && sent < 3 * triangles, "{r}");
+    assert!(strips["indices_drawn_median"].as_u64().unwrap() >= sent);
+    assert!(strips["step_us_median"].as_f64().unwrap() > 0.0);
+    assert!(list["step_us_median"].is_null());
+    for m in rows {
+        assert!(m["ms_per_frame"].as_f64().unwrap() > 0.0, "{m}");
+        assert!(m["gpu_bytes"].as_u64().unwrap() > 0, "{m}");
+    }
+}

@@ -43,8 +43,51 @@ pub(crate) fn map_indexed<S, T: Send>(
     done.into_iter().map(|(_, t)| t).collect()
 }
 
+/// `f` on every item, on up to all cores when there are at least `min`
+/// items (else on the caller alone: a thread costs tens of microseconds),
+/// items handed out `grain` at a time from a shared queue. A worker's
+/// panic is resumed on the caller.
+pub(crate) fn for_each_mut<T: Send>(
+    items: &mut [T],
+    min: usize,
+    grain: usize,
+    f: impl Fn(&mut T) + Sync,
+) {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, std::num::NonZeroUsize::get)
+        .min(items.len().div_ceil(grain.max(1)));
+    if threads < 2 || items.len() < min {
+        items.iter_mut().for_each(f);
+        return;
+    }
+    let queue = std::sync::Mutex::new(items.chunks_mut(grain.max(1)));
+    // A poisoned lock means another worker panicked: stop, and let the
+    // join below resume that panic.
+    let work = || {
+        while let Some(chunk) = queue.lock().ok().and_then(|mut q| q.next()) {
+            chunk.iter_mut().for_each(&f);
+        }
+    };
+    std::thread::scope(|scope| {
+        let workers: Vec<_> = (1..threads).map(|_| scope.spawn(work)).collect();
+        work();
+        for w in workers {
+            w.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+        }
+    });
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn for_each_mut_visits_every_item_once_above_and_below_the_minimum() {
+        for (n, min) in [(1000, 10), (1000, 2000), (3, 1), (0, 0)] {
+            let mut items: Vec<usize> = (0..n).collect();
+            super::for_each_mut(&mut items, min, 7, |x| *x = *x * 3 + 1);
+            assert_eq!(items, (0..n).map(|i| i * 3 + 1).collect::<Vec<_>>());
+        }
+    }
+
     #[test]
     fn results_come_in_item_order_with_per_worker_scratch() {
         let out = super::map_indexed(1000, Vec::new, |seen: &mut Vec<usize>, i| {

@@ -140,20 +140,32 @@ pub fn lod_for_screen_error(
     pixels_per_unit: f32,
     pixel_threshold: f32,
 ) -> usize {
+    relative_error_limit(diagonal, scale, pixels_per_unit, pixel_threshold)
+        .map_or(0, |limit| coarsest_within(collapses, limit))
+}
+
+/// The largest relative error (a [`Collapses::error`]) that
+/// [`lod_for_screen_error`] allows, `None` when its arguments ask for full
+/// detail.
+pub(crate) fn relative_error_limit(
+    diagonal: f32,
+    scale: f32,
+    pixels_per_unit: f32,
+    pixel_threshold: f32,
+) -> Option<f64> {
     let sane = |x: f32| x.is_finite() && x > 0.0;
     let diagonal_ok = diagonal.is_finite() && diagonal >= 0.0;
     if !sane(pixel_threshold) || !sane(scale) || !diagonal_ok || pixels_per_unit.is_nan() {
-        return 0;
+        return None;
     }
     // Largest allowed error relative to the diagonal: error × diagonal ×
     // scale × pixels_per_unit <= threshold.
     let per_relative = f64::from(diagonal) * f64::from(scale) * f64::from(pixels_per_unit);
-    let limit = if per_relative == 0.0 {
+    Some(if per_relative == 0.0 {
         f64::INFINITY
     } else {
         f64::from(pixel_threshold) / per_relative
-    };
-    coarsest_within(collapses, limit)
+    })
 }
 
 /// [`lod_for_screen_error`] for any [`LodSource`] built from `collapses`:
@@ -179,7 +191,7 @@ pub fn lod_for_screen_error_of(
 
 /// The coarsest LoD whose relative error is at most `limit` (binary search
 /// over the non-decreasing errors; LoD 0's is 0).
-fn coarsest_within(collapses: &Collapses, limit: f64) -> usize {
+pub(crate) fn coarsest_within(collapses: &Collapses, limit: f64) -> usize {
     let (mut lo, mut hi) = (0, collapses.max_lod());
     while lo < hi {
         let mid = (lo + hi).div_ceil(2);

@@ -48,12 +48,19 @@ fn view(eye: Vec3, px: f32, frustum: Option<Frustum>) -> View {
 
 #[test]
 fn the_arena_draws_the_cut_after_every_camera() {
-    let n = 40;
+    let n = 56;
+    // Small clusters, so that many groups change at once (see the end).
+    let options = HierarchyOptions {
+        cluster_triangles: 32,
+        group_clusters: 4,
+        ..HierarchyOptions::default()
+    };
     let mesh = hilly_grid(n);
-    let h = hierarchy::build(&mesh, &HierarchyOptions::default()).unwrap();
+    let h = hierarchy::build(&mesh, &options).unwrap();
     assert!(h.level_count() >= 3, "{} levels", h.level_count());
     let mut vd = ViewDependent::new(&h);
     let (mut changed, mut entered, mut left, mut clusters) = (0, 0, 0, 0);
+    let mut most_walks = 0;
     let eyes = path(n, 60);
     for px in [0.5f32, 2.0] {
         for (i, &eye) in eyes.iter().enumerate() {
@@ -82,13 +89,20 @@ fn the_arena_draws_the_cut_after_every_camera() {
                 "{context}"
             );
             changed += u.groups_changed;
+            most_walks = most_walks.max(u.groups_changed + u.groups_entered);
             entered += u.groups_entered;
             left += u.groups_left;
             clusters += u.clusters_entered;
         }
     }
-    // The flight exercised every kind of change.
+    // The flight exercised every kind of change, and some update walked
+    // enough groups to walk them on every core (runtime.rs,
+    // `PARALLEL_WALKS`: 24).
     assert!(changed > 0 && entered > 0 && left > 0 && clusters > 0);
+    assert!(
+        most_walks >= 24,
+        "at most {most_walks} groups walked at once"
+    );
 }
 
 #[test]

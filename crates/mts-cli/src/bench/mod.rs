@@ -22,6 +22,7 @@ pub mod figure6;
 pub mod measure;
 pub mod methods;
 pub mod render;
+pub mod render_hierarchy;
 pub mod report;
 pub mod results;
 pub mod scene;

@@ -1,10 +1,8 @@
 //! `mts bench render`: frames and triangles per second of the MTS strips
 //! against meshoptimizer-ordered triangle lists, headless, on the adapter
-//! at hand; and the cost of one LoD change (extraction plus upload).
-
-//! `mts bench render`: frames and triangles per second of the MTS strips
-//! against meshoptimizer-ordered triangle lists, headless, on the adapter
-//! at hand; and the cost of one LoD change (extraction plus upload).
+//! at hand; and the cost of one LoD change (extraction plus upload). A
+//! hierarchy is benched along a flight instead
+//! ([`super::render_hierarchy`]).
 
 use super::scene::{scene_rows, SceneSpec, SCENE_COMPARED_FRAMES};
 use super::vertex_work::measure_vertex_work;
@@ -46,6 +44,12 @@ pub struct BenchRenderArgs {
     #[arg(long, default_value_t = mts_render::scene::DEFAULT_PIXEL_ERROR,
           allow_hyphen_values = true, value_parser = crate::args::pixel_error)]
     pixel_error: f32,
+    /// Build the view-dependent hierarchy of the mesh (or --generated)
+    /// and bench it along the flight of `mts bench view-dependent`
+    /// (`--frames` cameras, `--pixel-error` px); a hierarchy's .mts file
+    /// is benched so without it.
+    #[arg(long)]
+    hierarchy: bool,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
@@ -186,6 +190,20 @@ fn lod_change_us(
 }
 
 pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
+    if let Some((name, h)) = crate::commands::render::load_hierarchy(&args.source, args.hierarchy)?
+    {
+        return super::render_hierarchy::bench_render_hierarchy(
+            &super::render_hierarchy::HierarchyBench {
+                name: &name,
+                h: &h,
+                cameras: args.frames,
+                width: args.size.0,
+                height: args.size.1,
+                pixel_error: args.pixel_error,
+                json: args.json,
+            },
+        );
+    }
     let (name, model) = args.source.model()?;
     let mesh = model.mesh();
     let gpu = Gpu::new_headless()?;

@@ -144,7 +144,7 @@ pub fn flight(lo: Vec3, hi: Vec3, t: f32) -> (Vec3, Vec3, bool) {
 }
 
 /// The flight's camera at `t`.
-fn camera_at(lo: Vec3, hi: Vec3, t: f32, aspect: f32) -> (Camera, Vec3) {
+pub(crate) fn camera_at(lo: Vec3, hi: Vec3, t: f32, aspect: f32) -> (Camera, Vec3) {
     let (eye, target, _) = flight(lo, hi, t);
     let scale = (hi - lo).length().max(f32::MIN_POSITIVE);
     (

@@ -20,13 +20,20 @@
 //! so every LoD) does not depend on it, so culling cannot open a crack in
 //! what is visible.
 //!
-//! **Cost.** An update selects (O(groups + their input clusters), no
-//! allocation once warm), merges the new cut with the previous one (both
+//! **Cost.** An update selects (O(open groups and their children), see
+//! [`select_into`]), merges the new cut with the previous one (both
 //! sorted), walks the extractors of groups whose LoD changed (only their
 //! changed strips, [`Extractor::set_lod`]) and copies their dirty ranges,
-//! mapped to input vertex numbers. Extractors are made when a group first
-//! enters the cut and kept after it leaves, so that returning costs a
-//! coherent walk, not a new extractor.
+//! mapped to input vertex numbers, into their slots. The walks and copies
+//! of one update run on every core when there are enough of them (each
+//! owns its extractor and its slot of the arena); the counts of indices
+//! and triangles are kept as groups come, go and change, not recounted.
+//! Extractors are made when a group first enters the cut and kept after
+//! it leaves, so that returning costs a coherent walk, not a new
+//! extractor. Along a flight the cost follows the camera's speed: on
+//! `terrain:4M` at 1 px, a crossing in 120 frames changes 290 of the
+//! 1,020 drawn groups a frame, one in 3,000 frames 18
+//! (`docs/experiments/hierarchy.md`, "Update time").
 
 use super::select::{select_into, Cut, Selection};
 use super::Hierarchy;
@@ -38,6 +45,27 @@ use std::ops::Range;
 
 /// "No slot" in [`ViewDependent`]'s slot tables.
 const NONE: u32 = u32::MAX;
+
+/// Groups to walk in one update from which the walks go on every core
+/// (below it, a thread's start costs more than it saves: a group walks in
+/// about 10 µs).
+const PARALLEL_WALKS: usize = 24;
+
+/// One group's walk in [`ViewDependent::update`].
+#[derive(Debug)]
+struct Walk<'h> {
+    group: u32,
+    lod: u32,
+    /// Whether the group enters the drawn set (else it changes LoD).
+    entering: bool,
+    /// Its slot in the arena (`len`: its extractor's buffer).
+    start: usize,
+    len: usize,
+    extractor: Extractor<'h>,
+    walked: usize,
+    /// Indices its drawn LoD sent before the walk (0 when entering).
+    indices_before: usize,
+}
 
 /// The six planes of a view frustum, inward normals (`n·p + d ≥ 0`
 /// inside), from a view-projection matrix with wgpu's clip space (`z` in
@@ -133,6 +161,9 @@ pub struct ViewDependent<'h> {
     next_clusters: Vec<u32>,
     /// The LoDs of `next_groups` (scratch).
     lods: Vec<u32>,
+    /// Groups to walk this update (scratch): group, LoD, its extractor
+    /// taken out of `extractors` while it walks, the strips it walked.
+    walks: Vec<Walk<'h>>,
     buffer: Vec<u32>,
     /// Free slots (start, length including the separating restart),
     /// ascending by start, none adjacent.
@@ -162,6 +193,7 @@ impl<'h> ViewDependent<'h> {
             next_groups: Vec::new(),
             next_clusters: Vec::new(),
             lods: Vec::new(),
+            walks: Vec::new(),
             buffer: Vec::new(),
             free: Vec::new(),
             dirty: Vec::new(),
@@ -229,15 +261,74 @@ impl<'h> ViewDependent<'h> {
             self.release_cluster(c);
             update.clusters_left += 1;
         });
+        // Groups entering or changing LoD walk their extractors and copy
+        // what changed into their slots, on every core: each walk owns its
+        // extractor and its slot. Entering groups take their slots first,
+        // in group order.
+        let mut walks = std::mem::take(&mut self.walks);
+        walks.clear();
         for (&g, &lod) in next_groups.iter().zip(&lods) {
-            if self.group_slot[g as usize] == NONE {
-                update.groups_entered += 1;
-                update.strips_walked += self.place_group(g, lod);
-            } else if self.group_lod[g as usize] != lod {
-                update.groups_changed += 1;
-                update.strips_walked += self.walk_group(g, lod);
+            let gi = g as usize;
+            let entering = self.group_slot[gi] == NONE;
+            if !entering && self.group_lod[gi] == lod {
+                continue;
             }
+            let model = &h.groups[gi].model;
+            let extractor = self.extractors[gi]
+                .take()
+                .unwrap_or_else(|| Extractor::new(model));
+            let len = extractor.buffer().len();
+            let (start, indices_before) = if entering {
+                let start = allocate(&mut self.free, &mut self.buffer, len + 1);
+                (start, 0)
+            } else {
+                (self.group_slot[gi] as usize, extractor.indices_sent())
+            };
+            walks.push(Walk {
+                group: g,
+                lod,
+                entering,
+                start,
+                len,
+                extractor,
+                walked: 0,
+                indices_before,
+            });
         }
+        walks.sort_unstable_by_key(|w| w.start);
+        let mut jobs: Vec<(&mut Walk<'h>, &mut [u32])> = Vec::with_capacity(walks.len());
+        let (mut rest, mut offset) = (&mut self.buffer[..], 0);
+        for w in &mut walks {
+            let (_, tail) = std::mem::take(&mut rest).split_at_mut(w.start - offset);
+            let (slot, tail) = tail.split_at_mut(w.len);
+            (rest, offset) = (tail, w.start + w.len);
+            jobs.push((w, slot));
+        }
+        crate::parallel::for_each_mut(&mut jobs, PARALLEL_WALKS, 8, |(w, slot)| {
+            let vertices = &h.groups[w.group as usize].vertices;
+            let e = &mut w.extractor;
+            w.walked = e.set_lod(w.lod as usize).strips_walked;
+            if w.entering {
+                let active = e.active_range();
+                copy_mapped(&mut slot[active.clone()], &e.buffer()[active], vertices);
+            } else {
+                for r in e.dirty_ranges() {
+                    copy_mapped(&mut slot[r.clone()], &e.buffer()[r.clone()], vertices);
+                }
+            }
+        });
+        drop(jobs);
+        walks.sort_unstable_by_key(|w| w.group);
+        for w in walks.drain(..) {
+            update.strips_walked += w.walked;
+            if w.entering {
+                update.groups_entered += 1;
+            } else {
+                update.groups_changed += 1;
+            }
+            self.landed(w);
+        }
+        self.walks = walks;
         for &c in &next_clusters {
             if self.cluster_slot[c as usize] == NONE {
                 update.clusters_entered += 1;
@@ -254,7 +345,8 @@ impl<'h> ViewDependent<'h> {
             r.end = r.end.min(len);
             r.start < r.end
         });
-        self.count();
+        #[cfg(debug_assertions)]
+        self.check_counts();
         update.indices_written = self.dirty.iter().map(Range::len).sum();
         update
     }
@@ -320,111 +412,81 @@ impl<'h> ViewDependent<'h> {
             + 8 * self.free.capacity()
     }
 
-    /// Indices and triangles of what is drawn now.
-    fn count(&mut self) {
+    /// Checks the running counts against a recount of what is drawn.
+    #[cfg(debug_assertions)]
+    fn check_counts(&self) {
         let h = self.h;
         let (mut indices, mut triangles) = (0, 0);
         for &g in &self.drawn_groups {
             if let Some(e) = &self.extractors[g as usize] {
                 indices += e.indices_sent();
-                triangles += h.groups[g as usize]
-                    .model
-                    .triangle_count(self.group_lod[g as usize] as usize);
+                triangles += self.group_triangles(g, self.group_lod[g as usize]);
             }
         }
         for &c in &self.drawn_clusters {
             indices += h.cluster_strip(c as usize).len();
             triangles += h.cluster_triangle_count(c as usize);
         }
-        self.indices_sent = indices;
-        self.triangles = triangles;
+        debug_assert_eq!((indices, triangles), (self.indices_sent, self.triangles));
     }
 
-    /// Puts group `g` at `lod` into a new slot; returns the strips walked.
-    fn place_group(&mut self, g: u32, lod: u32) -> usize {
-        let h = self.h;
-        let group = &h.groups[g as usize];
-        let extractor =
-            self.extractors[g as usize].get_or_insert_with(|| Extractor::new(&group.model));
-        let walked = extractor.set_lod(lod as usize).strips_walked;
-        let len = extractor.buffer().len();
-        let start = self.allocate(len + 1);
-        let extractor = self.extractors[g as usize].as_ref().expect("made above");
-        let active = extractor.active_range();
-        copy_mapped(
-            &mut self.buffer[start + active.start..start + active.end],
-            &extractor.buffer()[active.clone()],
-            &group.vertices,
-        );
-        // The separating restart too: a GPU buffer may hold anything there
-        // after the arena shrank and grew again.
-        self.dirty.push(start..start + len + 1);
-        self.group_slot[g as usize] = start as u32;
-        self.group_lod[g as usize] = lod;
-        walked
+    /// Triangles group `g` draws at `lod`.
+    fn group_triangles(&self, g: u32, lod: u32) -> usize {
+        self.h.groups[g as usize].model.triangle_count(lod as usize)
     }
 
-    /// Moves drawn group `g` to `lod`: a coherent walk, its dirty ranges
-    /// copied. Returns the strips walked.
-    fn walk_group(&mut self, g: u32, lod: u32) -> usize {
-        let group = &self.h.groups[g as usize];
-        let start = self.group_slot[g as usize] as usize;
-        let Some(extractor) = self.extractors[g as usize].as_mut() else {
-            return 0;
-        };
-        let walked = extractor.set_lod(lod as usize).strips_walked;
-        for r in extractor.dirty_ranges() {
-            copy_mapped(
-                &mut self.buffer[start + r.start..start + r.end],
-                &extractor.buffer()[r.clone()],
-                &group.vertices,
-            );
-            self.dirty.push(start + r.start..start + r.end);
+    /// Records walk `w`, its indices copied into its slot: the dirty
+    /// ranges (a new slot whole, with its separating restart: a GPU buffer
+    /// may hold anything there after the arena shrank and grew again), the
+    /// counts, the slot and LoD; the extractor goes back to its place.
+    fn landed(&mut self, w: Walk<'h>) {
+        let g = w.group as usize;
+        let e = w.extractor;
+        if w.entering {
+            self.dirty.push(w.start..w.start + w.len + 1);
+            self.group_slot[g] = w.start as u32;
+        } else {
+            let s = w.start;
+            self.dirty
+                .extend(e.dirty_ranges().iter().map(|r| s + r.start..s + r.end));
+            self.triangles -= self.group_triangles(w.group, self.group_lod[g]);
         }
-        self.group_lod[g as usize] = lod;
-        walked
+        self.indices_sent = self.indices_sent + e.indices_sent() - w.indices_before;
+        self.triangles += self.group_triangles(w.group, w.lod);
+        self.group_lod[g] = w.lod;
+        self.extractors[g] = Some(e);
     }
 
     fn release_group(&mut self, g: u32) {
         let start = self.group_slot[g as usize];
+        let lod = self.group_lod[g as usize];
         self.group_slot[g as usize] = NONE;
         self.group_lod[g as usize] = NONE;
         if let Some(e) = &self.extractors[g as usize] {
-            let len = e.buffer().len();
+            let (len, indices) = (e.buffer().len(), e.indices_sent());
+            self.indices_sent -= indices;
+            self.triangles -= self.group_triangles(g, lod);
             self.release(start as usize, len + 1);
         }
     }
 
     fn place_cluster(&mut self, c: u32) {
         let strip = self.h.cluster_strip(c as usize);
-        let start = self.allocate(strip.len() + 1);
+        let start = allocate(&mut self.free, &mut self.buffer, strip.len() + 1);
         self.buffer[start..start + strip.len()].copy_from_slice(strip);
         self.dirty.push(start..start + strip.len() + 1);
         self.cluster_slot[c as usize] = start as u32;
+        self.indices_sent += strip.len();
+        self.triangles += self.h.cluster_triangle_count(c as usize);
     }
 
     fn release_cluster(&mut self, c: u32) {
         let start = self.cluster_slot[c as usize];
         self.cluster_slot[c as usize] = NONE;
         let len = self.h.cluster_strip(c as usize).len();
+        self.indices_sent -= len;
+        self.triangles -= self.h.cluster_triangle_count(c as usize);
         self.release(start as usize, len + 1);
-    }
-
-    /// A slot of `len` indices (all restarts): the first free one that
-    /// fits, else the arena's end.
-    fn allocate(&mut self, len: usize) -> usize {
-        if let Some(i) = self.free.iter().position(|&(_, l)| l as usize >= len) {
-            let (start, l) = self.free[i];
-            if l as usize == len {
-                self.free.remove(i);
-            } else {
-                self.free[i] = (start + len as u32, l - len as u32);
-            }
-            return start as usize;
-        }
-        let start = self.buffer.len();
-        self.buffer.resize(start + len, RESTART_U32);
-        start
     }
 
     /// Fills slot `start..start + len` with restarts and frees it.
@@ -466,6 +528,23 @@ fn copy_mapped(target: &mut [u32], source: &[u32], vertices: &[u32]) {
             vertices[v as usize]
         };
     }
+}
+
+/// A slot of `len` indices (all restarts): the first free one that
+/// fits, else the arena's end.
+fn allocate(free: &mut Vec<(u32, u32)>, buffer: &mut Vec<u32>, len: usize) -> usize {
+    if let Some(i) = free.iter().position(|&(_, l)| l as usize >= len) {
+        let (start, l) = free[i];
+        if l as usize == len {
+            free.remove(i);
+        } else {
+            free[i] = (start + len as u32, l - len as u32);
+        }
+        return start as usize;
+    }
+    let start = buffer.len();
+    buffer.resize(start + len, RESTART_U32);
+    start
 }
 
 /// Calls `f` on every element of `old` not in `new` (both ascending).

@@ -43,7 +43,7 @@
 //! cameras.
 
 use super::{Hierarchy, NO_GROUP};
-use crate::screen_error::{lod_for_screen_error, Projection};
+use crate::screen_error::{coarsest_within, relative_error_limit, Projection};
 use glam::Vec3;
 
 /// What one camera draws of a [`Hierarchy`], from [`select`].
@@ -126,23 +126,131 @@ pub fn select(h: &Hierarchy, projection: &Projection, eye: Vec3, pixel_threshold
 pub struct Selection {
     /// `(groups, clusters)` of the hierarchy the table was made for.
     made_for: Option<(usize, usize)>,
-    centre: Vec<[f64; 3]>,
-    radius: Vec<f64>,
-    output_error: Vec<f64>,
-    floor: Vec<f64>,
-    /// `children[children_start[g]..children_start[g + 1]]`.
+    /// Per group: its grown sphere and output error, in one cache line's
+    /// reach (the traversal reads little else).
+    spheres: Vec<Sphere>,
+    /// `children[children_start[g]..children_start[g + 1]]`, with each
+    /// child's sphere beside it in `child_spheres` (a copy: a visit reads
+    /// its children's spheres in a row, not from all over `spheres`).
     children_start: Vec<u32>,
     children: Vec<u32>,
-    /// Input clusters and their producers, `inputs_start` as above.
+    child_spheres: Vec<Sphere>,
+    /// Input clusters and their producers (and producers' spheres, as
+    /// above), `inputs_start` as above.
     inputs_start: Vec<u32>,
     input_cluster: Vec<u32>,
     input_producer: Vec<u32>,
+    producer_spheres: Vec<Sphere>,
     /// Groups no group consumes the output of.
     roots: Vec<u32>,
     /// Per group, the selection that last visited it.
     visited: Vec<u32>,
+    /// Per group, its last LoD from [`lod_for_screen_error`]'s rule and the
+    /// relative-error limits it holds for (`lo <= limit < hi`), so that a
+    /// camera that moved a little finds most LoDs without reading the
+    /// group's error table.
+    lods: Vec<LodMemo>,
     stamp: u32,
     stack: Vec<u32>,
+}
+
+/// See [`Selection::lods`]; with the group's diagonal and floor, so that
+/// a memo that holds reads nothing else.
+#[derive(Debug, Clone, Copy)]
+struct LodMemo {
+    lod: u32,
+    diagonal: f32,
+    floor: f64,
+    lo: f64,
+    hi: f64,
+}
+
+impl LodMemo {
+    /// Holds for no limit.
+    fn new(diagonal: f32, floor: f64) -> LodMemo {
+        LodMemo {
+            lod: 0,
+            diagonal,
+            floor,
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+        }
+    }
+}
+
+/// A group's sphere (grown, see [`Selection`]) and output error.
+#[derive(Debug, Clone, Copy, Default)]
+struct Sphere {
+    centre: [f64; 3],
+    radius: f64,
+    error: f64,
+}
+
+/// The projected-error test of one selection, with what does not depend
+/// on the group worked out once: a perspective camera's error `e` at
+/// distance `d - r` projects to `e × k / (d - r)` pixels (`k` the pixels
+/// per unit at distance 1), within `t` exactly when `d ≥ r + e × k / t`,
+/// which needs no square root, tangent or division per group (compared
+/// squared). The same inequality as [`Projection::pixels_per_unit`] and
+/// [`lod_for_screen_error`] evaluate, rearranged; rounding may move a
+/// group lying on the threshold to either side, and [`select_exhaustive`]
+/// uses the same test.
+#[derive(Debug, Clone, Copy)]
+enum Fit {
+    /// No threshold: nothing is coarse (full detail).
+    Never,
+    /// A degenerate projection (0 pixels per unit): everything fits.
+    Always,
+    /// Fits when the distance from `eye` is at least `r + e × per_error`.
+    Perspective { eye: [f64; 3], per_error: f64 },
+    /// Fits when the error is at most `max_error`.
+    Orthographic { max_error: f64 },
+}
+
+impl Fit {
+    fn new(projection: &Projection, eye: Vec3, pixel_threshold: f32) -> Fit {
+        if !(pixel_threshold.is_finite() && pixel_threshold > 0.0) {
+            return Fit::Never;
+        }
+        let t = f64::from(pixel_threshold);
+        // Pixels per unit at distance 1: `k` for a perspective camera,
+        // the constant for an orthographic one; 0 when degenerate.
+        let k = f64::from(projection.pixels_per_unit(1.0));
+        if k.is_nan() {
+            return Fit::Never;
+        }
+        if k == 0.0 {
+            return Fit::Always;
+        }
+        match projection {
+            Projection::Perspective { .. } => Fit::Perspective {
+                eye: eye.as_dvec3().to_array(),
+                per_error: k / t,
+            },
+            Projection::Orthographic { .. } => Fit::Orthographic { max_error: t / k },
+        }
+    }
+
+    /// Whether a group's output projects within the threshold (see
+    /// [`Selection`] for why this is monotone down the DAG).
+    #[inline]
+    fn fits(self, s: &Sphere) -> bool {
+        if s.error == 0.0 {
+            return !matches!(self, Fit::Never);
+        }
+        match self {
+            Fit::Never => false,
+            Fit::Always => true,
+            Fit::Perspective { eye, per_error } => {
+                let c = s.centre;
+                let d2 =
+                    (eye[0] - c[0]).powi(2) + (eye[1] - c[1]).powi(2) + (eye[2] - c[2]).powi(2);
+                let need = s.radius + s.error * per_error;
+                d2 >= need * need
+            }
+            Fit::Orthographic { max_error } => s.error <= max_error,
+        }
+    }
 }
 
 impl Selection {
@@ -155,21 +263,34 @@ impl Selection {
             let c = g.centre.as_dvec3();
             let mut r = f64::from(g.radius);
             for &child in &g.children {
-                let child = child as usize;
-                let cc = self.centre[child];
+                let child = &self.spheres[child as usize];
+                let cc = child.centre;
                 let d =
                     ((cc[0] - c.x).powi(2) + (cc[1] - c.y).powi(2) + (cc[2] - c.z).powi(2)).sqrt();
-                r = r.max(d + self.radius[child]);
+                r = r.max(d + child.radius);
             }
-            self.centre.push(c.to_array());
-            self.radius.push(r * (1.0 + 1e-9) + f64::MIN_POSITIVE);
-            self.output_error.push(f64::from(g.output_error()));
-            self.floor.push(f64::from(g.floor));
+            self.spheres.push(Sphere {
+                centre: c.to_array(),
+                radius: r * (1.0 + 1e-9) + f64::MIN_POSITIVE,
+                error: f64::from(g.output_error()),
+            });
+            self.lods.push(LodMemo::new(g.diagonal, f64::from(g.floor)));
             self.children.extend_from_slice(&g.children);
+            for &child in &g.children {
+                self.child_spheres.push(self.spheres[child as usize]);
+            }
             self.children_start.push(self.children.len() as u32);
             for &c in &g.inputs {
+                let producer = h.clusters[c as usize].producer;
                 self.input_cluster.push(c);
-                self.input_producer.push(h.clusters[c as usize].producer);
+                self.input_producer.push(producer);
+                // A producer comes before its consumer (a level below).
+                self.producer_spheres.push(
+                    self.spheres
+                        .get(producer as usize)
+                        .copied()
+                        .unwrap_or_default(),
+                );
             }
             self.inputs_start.push(self.input_cluster.len() as u32);
             let root = g
@@ -185,28 +306,59 @@ impl Selection {
     }
 
     /// Pixels per model unit at group `g`'s nearest point.
-    fn scale(&self, g: usize, projection: &Projection, eye: [f64; 3]) -> f32 {
-        let c = self.centre[g];
-        let d =
-            ((eye[0] - c[0]).powi(2) + (eye[1] - c[1]).powi(2) + (eye[2] - c[2]).powi(2)).sqrt();
-        projection.pixels_per_unit((d - self.radius[g]).max(0.0) as f32)
+    fn scale(&self, g: usize, projection: &Projection, eye: Vec3) -> f32 {
+        let c = self.spheres[g].centre;
+        let eye = eye.as_dvec3();
+        let d = ((eye.x - c[0]).powi(2) + (eye.y - c[1]).powi(2) + (eye.z - c[2]).powi(2)).sqrt();
+        projection.pixels_per_unit((d - self.spheres[g].radius).max(0.0) as f32)
     }
 
-    /// Whether group `g`'s output projects within `threshold` (see
-    /// [`Selection`] for why this is monotone down the DAG).
-    fn fits(
-        &self,
+    /// The LoD an open group whose children are all coarse draws: its last
+    /// when it fits itself (a coarse root), else the coarsest within the
+    /// threshold at its nearest point, LoD 0 when even its floor (the
+    /// error its inputs carry) does not fit there.
+    fn lod_of(
+        &mut self,
+        h: &Hierarchy,
         g: usize,
+        fit: Fit,
         projection: &Projection,
-        eye: [f64; 3],
-        threshold: Option<f64>,
-    ) -> bool {
-        let Some(threshold) = threshold else {
-            return false;
+        eye: Vec3,
+        pixel_threshold: f32,
+    ) -> usize {
+        if fit.fits(&self.spheres[g]) {
+            return h.groups[g].model.max_lod();
+        }
+        if matches!(fit, Fit::Never) {
+            return 0;
+        }
+        let scale = self.scale(g, projection, eye);
+        let memo = self.lods[g];
+        if memo.floor * f64::from(scale) > f64::from(pixel_threshold) {
+            return 0;
+        }
+        // `lod_for_screen_error(collapses, diagonal, 1, scale, threshold)`,
+        // remembered by the limit it answered for.
+        let Some(limit) = relative_error_limit(memo.diagonal, 1.0, scale, pixel_threshold) else {
+            return 0;
         };
-        let ppu = self.scale(g, projection, eye);
-        let error = self.output_error[g];
-        !ppu.is_nan() && (error == 0.0 || error * f64::from(ppu) <= threshold)
+        if memo.lo <= limit && limit < memo.hi {
+            return memo.lod as usize;
+        }
+        let collapses = h.groups[g].model.collapses();
+        let lod = coarsest_within(collapses, limit);
+        let hi = if lod < collapses.max_lod() {
+            f64::from(collapses.error(lod + 1))
+        } else {
+            f64::INFINITY
+        };
+        self.lods[g] = LodMemo {
+            lod: lod as u32,
+            lo: f64::from(collapses.error(lod)),
+            hi,
+            ..memo
+        };
+        lod
     }
 }
 
@@ -230,9 +382,7 @@ pub fn select_into(
         scratch.make(h);
     }
     let s = scratch;
-    let threshold = (pixel_threshold.is_finite() && pixel_threshold > 0.0)
-        .then_some(f64::from(pixel_threshold));
-    let eye = eye.as_dvec3().to_array();
+    let fit = Fit::new(projection, eye, pixel_threshold);
     cut.groups.clear();
     cut.clusters.clear();
     s.stamp = s.stamp.wrapping_add(1);
@@ -255,36 +405,19 @@ pub fn select_into(
             s.children_start[gi + 1] as usize,
         );
         let mut all_coarse = true;
-        for &c in &s.children[a..b] {
-            if !s.fits(c as usize, projection, eye, threshold) {
+        for (&c, sphere) in s.children[a..b].iter().zip(&s.child_spheres[a..b]) {
+            if !fit.fits(sphere) {
                 all_coarse = false;
                 stack.push(c);
             }
         }
         if all_coarse {
-            let group = &h.groups[gi];
-            let lod = if s.fits(gi, projection, eye, threshold) {
-                // A coarse root.
-                group.model.max_lod()
-            } else {
-                let scale = s.scale(gi, projection, eye);
-                match threshold {
-                    Some(t) if s.floor[gi] * f64::from(scale) <= t => lod_for_screen_error(
-                        group.model.collapses(),
-                        group.diagonal,
-                        1.0,
-                        scale,
-                        pixel_threshold,
-                    ),
-                    _ => 0,
-                }
-            };
+            let lod = s.lod_of(h, gi, fit, projection, eye, pixel_threshold);
             cut.groups.push((g, lod as u32));
         } else {
             let (a, b) = (s.inputs_start[gi] as usize, s.inputs_start[gi + 1] as usize);
             for i in a..b {
-                let producer = s.input_producer[i];
-                if producer != NO_GROUP && s.fits(producer as usize, projection, eye, threshold) {
+                if s.input_producer[i] != NO_GROUP && fit.fits(&s.producer_spheres[i]) {
                     cut.clusters.push(s.input_cluster[i]);
                 }
             }
@@ -308,14 +441,11 @@ pub fn select_exhaustive(
 ) -> Cut {
     let mut s = Selection::default();
     s.make(h);
-    let threshold = (pixel_threshold.is_finite() && pixel_threshold > 0.0)
-        .then_some(f64::from(pixel_threshold));
-    let eye64 = eye.as_dvec3().to_array();
+    let fit = Fit::new(projection, eye, pixel_threshold);
     let n = h.groups.len();
     let mut coarse = vec![false; n];
     for (i, g) in h.groups.iter().enumerate() {
-        coarse[i] = s.fits(i, projection, eye64, threshold)
-            && g.children.iter().all(|&c| coarse[c as usize]);
+        coarse[i] = fit.fits(&s.spheres[i]) && g.children.iter().all(|&c| coarse[c as usize]);
     }
     let mut cut = Cut::default();
     for (i, g) in h.groups.iter().enumerate() {
@@ -324,21 +454,7 @@ pub fn select_exhaustive(
             continue;
         }
         if g.children.iter().all(|&c| coarse[c as usize]) {
-            let scale = s.scale(i, projection, eye64);
-            let lod = if coarse[i] {
-                g.model.max_lod()
-            } else {
-                match threshold {
-                    Some(t) if s.floor[i] * f64::from(scale) <= t => lod_for_screen_error(
-                        g.model.collapses(),
-                        g.diagonal,
-                        1.0,
-                        scale,
-                        pixel_threshold,
-                    ),
-                    _ => 0,
-                }
-            };
+            let lod = s.lod_of(h, i, fit, projection, eye, pixel_threshold);
             cut.groups.push((i as u32, lod as u32));
         } else {
             for &c in &g.inputs {
