@@ -591,3 +591,38 @@ proptest::proptest! {
         }
     }
 }
+
+/// `build_with_progress` reports every group once, from any thread: the
+/// triangles reported add up to every group's input over all levels, which
+/// is the input's at level 0 and about half as much again per level, and
+/// the hierarchy is the one `build` makes.
+#[test]
+fn build_reports_its_progress_group_by_group() {
+    let mesh = "terrain:20k".parse::<Generated>().unwrap().build();
+    let options = HierarchyOptions::default();
+    let calls = std::sync::Mutex::new(Vec::new());
+    let h = hierarchy::build_with_progress(&mesh, &options, &|p| {
+        calls.lock().unwrap().push(p);
+    })
+    .unwrap();
+    let calls = calls.into_inner().unwrap();
+    assert_eq!(calls.len(), h.groups().len());
+    let expected = 2 * mesh.triangle_count();
+    assert!(calls.iter().all(|p| p.triangles_expected == expected));
+    let last = calls.iter().map(|p| p.triangles_done).max().unwrap();
+    let inputs: usize = h
+        .groups()
+        .iter()
+        .flat_map(|g| &g.inputs)
+        .map(|&c| h.cluster_triangle_count(c as usize))
+        .sum();
+    assert_eq!(last, inputs);
+    assert!(
+        last > mesh.triangle_count() && last < expected + expected / 10,
+        "{last}"
+    );
+    let levels = calls.iter().map(|p| p.level).max().unwrap() as usize;
+    assert_eq!(levels + 1, h.level_count());
+    let plain = hierarchy::build(&mesh, &options).unwrap();
+    assert_eq!(plain.to_bytes(), h.to_bytes());
+}

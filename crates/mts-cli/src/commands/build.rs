@@ -191,7 +191,7 @@ fn run_hierarchy(
         ..Default::default()
     };
     let started = std::time::Instant::now();
-    let h = hierarchy_with_spinner(mesh, &options)?;
+    let h = hierarchy_with_progress(mesh, &options)?;
     let build = started.elapsed();
     let bytes = h.to_bytes();
     mts::output::write_file(&args.output, &bytes)?;
@@ -243,24 +243,30 @@ fn run_hierarchy(
     Ok(())
 }
 
-/// [`mts::hierarchy::build`] with a spinner on large inputs (the core
-/// reports no progress from inside it).
-fn hierarchy_with_spinner(
+/// [`mts::hierarchy::build`] with a progress bar on large inputs: the
+/// triangles of the groups built, every level counted, against about
+/// twice the input's.
+fn hierarchy_with_progress(
     mesh: &Mesh,
     options: &mts::hierarchy::HierarchyOptions,
 ) -> mts::Result<mts::hierarchy::Hierarchy> {
     use indicatif::{ProgressBar, ProgressStyle};
+    let expected = 2 * mesh.triangle_count() as u64;
     let bar = if mesh.triangle_count() >= PROGRESS_MIN_TRIANGLES {
-        ProgressBar::new_spinner()
+        ProgressBar::new(expected)
     } else {
         ProgressBar::hidden()
     };
     bar.set_style(
-        ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid template"),
+        ProgressStyle::with_template(
+            "hierarchy, groups on every core: {wide_bar} {percent}% {msg} {elapsed} (eta {eta})",
+        )
+        .expect("valid template"),
     );
-    bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    bar.set_message("hierarchy (groups on every core)");
-    let out = mts::hierarchy::build(mesh, options);
+    let out = mts::hierarchy::build_with_progress(mesh, options, &|p| {
+        bar.set_position((p.triangles_done as u64).min(expected));
+        bar.set_message(format!("level {}", p.level));
+    });
     bar.finish_and_clear();
     out
 }

@@ -28,6 +28,32 @@ use glam::Vec3;
 /// # Panics
 /// If `mesh` breaks the [`Mesh`] invariants.
 pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy> {
+    build_with_progress(mesh, options, &|_| {})
+}
+
+/// How far [`build_with_progress`] is: the triangles of the groups built
+/// so far, over all levels, against about twice the input's (each level
+/// about half the one below; the count may end a little above or below).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BuildProgress {
+    /// The level being built (0: the input's clusters).
+    pub level: u32,
+    /// Input triangles of the groups built so far, every level counted.
+    pub triangles_done: usize,
+    /// Twice the input's triangles: what `triangles_done` approaches.
+    pub triangles_expected: usize,
+}
+
+/// [`build`], calling `progress` (from any thread, in no particular
+/// order) after each group is built.
+///
+/// # Errors
+/// As [`build`].
+pub fn build_with_progress(
+    mesh: &Mesh,
+    options: &HierarchyOptions,
+    progress: &(dyn Fn(BuildProgress) + Sync),
+) -> crate::Result<Hierarchy> {
     if options.pipeline.simplify.placement != Placement::Endpoint {
         return Err(crate::Error::InvalidArgument(
             "the hierarchy needs endpoint placement: its groups draw input vertices".into(),
@@ -56,6 +82,7 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
         current.push(h.add_cluster(&mut triangles, tris, NO_GROUP));
     }
     let mut level = 0u32;
+    let done = std::sync::atomic::AtomicUsize::new(0);
     while !current.is_empty() {
         let slices: Vec<&[[u32; 3]]> = current
             .iter()
@@ -96,7 +123,14 @@ pub fn build(mesh: &Mesh, options: &HierarchyOptions) -> crate::Result<Hierarchy
                     .collect()
             })
             .collect();
-        let built = build_groups(mesh, &inputs, &shared, options);
+        let built = build_groups(mesh, &inputs, &shared, options, &|triangles| {
+            let before = done.fetch_add(triangles, std::sync::atomic::Ordering::Relaxed);
+            progress(BuildProgress {
+                level,
+                triangles_done: before + triangles,
+                triangles_expected: 2 * mesh.triangle_count(),
+            });
+        });
         let (mut total_in, mut total_out) = (0usize, 0usize);
         let mut next = Vec::new();
         for (gi, b) in built.into_iter().enumerate() {
@@ -188,17 +222,23 @@ struct Built {
     radius: f32,
 }
 
-/// [`build_group`] of every group, on all cores, in group order.
+/// [`build_group`] of every group, on all cores, in group order; `built`
+/// is told each group's input triangles once it is built.
 fn build_groups(
     mesh: &Mesh,
     inputs: &[Vec<[u32; 3]>],
     shared: &[bool],
     options: &HierarchyOptions,
+    built: &(dyn Fn(usize) + Sync),
 ) -> Vec<Built> {
     crate::parallel::map_indexed(
         inputs.len(),
         || vec![u32::MAX; mesh.vertex_count()],
-        |remap, i| build_group(mesh, &inputs[i], shared, options, remap),
+        |remap, i| {
+            let b = build_group(mesh, &inputs[i], shared, options, remap);
+            built(inputs[i].len());
+            b
+        },
     )
 }
 

@@ -38,7 +38,7 @@ mod runtime;
 mod select;
 mod strips;
 
-pub use build::build;
+pub use build::{build, build_with_progress, BuildProgress};
 pub use cracks::cracks;
 pub use runtime::{FrameUpdate, Frustum, View, ViewDependent};
 pub use select::{select, select_exhaustive, select_into, Cut, Selection};
