@@ -1,6 +1,7 @@
-//! Times [`mts::hierarchy::ViewDependent::update`] along a low flight over
-//! a hierarchy file (the bench's terrain flight: corner to corner, 40°
-//! vertical field of view), with no frustum, for profiling.
+//! Times [`mts::hierarchy::ViewDependent::update`] along the flight of
+//! `mts bench view-dependent` over a hierarchy file (low over a terrain,
+//! corner to corner; around anything else; 40° vertical field of view),
+//! with no frustum, for profiling.
 //!
 //! `cargo run --release -p mts --example flight_profile -- H.mts [FRAMES] [PX] [HEIGHT] [PASSES]`
 //! (passes fly there and back, for a profiler's sake).
@@ -81,10 +82,22 @@ fn bounds(p: &[Vec3]) -> (Vec3, Vec3) {
     })
 }
 
-/// The eye of the bench's terrain flight at `t` in 0..=1.
+/// The eye of the bench's flight at `t` in 0..=1: low over a terrain (a
+/// box flat along `y`), else circling the box while closing in.
 fn eye_at(lo: Vec3, hi: Vec3, t: f32) -> Vec3 {
     let extent = hi - lo;
     let largest = extent.max_element();
+    if extent.y >= 0.25 * largest {
+        let radius = 0.5 * extent.length();
+        let angle = t * 3.0 * std::f32::consts::PI;
+        let distance = radius * (2.2 - 1.4 * t);
+        return 0.5 * (lo + hi)
+            + Vec3::new(
+                distance * angle.cos(),
+                0.2 * radius * (2.0 * angle).sin(),
+                distance * angle.sin(),
+            );
+    }
     let from = Vec3::new(lo.x + 0.05 * extent.x, 0.0, lo.z + 0.05 * extent.z);
     let to = Vec3::new(hi.x - 0.05 * extent.x, 0.0, hi.z - 0.25 * extent.z);
     let ground = from.lerp(to, t);

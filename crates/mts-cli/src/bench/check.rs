@@ -343,6 +343,18 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
                 r.view_dependent.len()
             ),
         );
+    } else {
+        // The terrain, then the scans of VIEW_DEPENDENT_SCANS the run
+        // measured.
+        need(
+            !r.view_dependent.is_empty()
+                && r.view_dependent.len() <= 1 + super::measure::VIEW_DEPENDENT_SCANS.len(),
+            format!(
+                "{} view-dependent runs, a full run flies the terrain and up to {} scans",
+                r.view_dependent.len(),
+                super::measure::VIEW_DEPENDENT_SCANS.len()
+            ),
+        );
     }
     for (i, run) in r.view_dependent.iter().enumerate() {
         let thresholds: Option<&[f64]> = match (i, quick) {
@@ -470,6 +482,15 @@ mod tests {
         let r = committed();
         assert_eq!(check(&r, false), Vec::<String>::new());
         assert!(check(&r, true).iter().any(|e| e.contains("quick is false")));
+        let mut broken = r.clone();
+        broken.view_dependent.clear();
+        assert!(
+            check(&broken, false)
+                .iter()
+                .any(|e| e.starts_with("0 view-dependent runs")),
+            "{:?}",
+            check(&broken, false)
+        );
         let mut broken = r.clone();
         let name = broken.models[3].name.clone();
         let level = &mut broken.models[3].levels[2];
