@@ -1,7 +1,7 @@
 //! Chooses what a camera draws of a [`Hierarchy`]: a cut of the DAG, after
 //! Karis's Nanite rule as meshoptimizer's cluster LoD applies it, made
 //! continuous: the groups on the cut draw their models at the coarsest LoD
-//! within the pixel threshold (the core's [`lod_for_screen_error`] rule at
+//! within the pixel threshold (the core's [`lod_for_screen_error`](crate::lod_for_screen_error) rule at
 //! the group's nearest point).
 //!
 //! **The rule.** A group is *coarse* when its output error, projected at
@@ -94,7 +94,7 @@ impl Cut {
 /// `projection`, with at most `pixel_threshold` pixels of projected error
 /// (see the module documentation for the rule and why it has no crack).
 /// A threshold that is not a finite number above 0 draws full detail, as
-/// [`lod_for_screen_error`] does.
+/// [`lod_for_screen_error`](crate::lod_for_screen_error) does.
 ///
 /// Cost: as [`select_into`], plus the allocation of the cut and of the
 /// selection table (O(groups)); [`select_into`] reuses them.
@@ -145,7 +145,7 @@ pub struct Selection {
     roots: Vec<u32>,
     /// Per group, the selection that last visited it.
     visited: Vec<u32>,
-    /// Per group, its last LoD from [`lod_for_screen_error`]'s rule and the
+    /// Per group, its last LoD from [`lod_for_screen_error`](crate::lod_for_screen_error)'s rule and the
     /// relative-error limits it holds for (`lo <= limit < hi`), so that a
     /// camera that moved a little finds most LoDs without reading the
     /// group's error table.
@@ -192,7 +192,7 @@ struct Sphere {
 /// per unit at distance 1), within `t` exactly when `d ≥ r + e × k / t`,
 /// which needs no square root, tangent or division per group (compared
 /// squared). The same inequality as [`Projection::pixels_per_unit`] and
-/// [`lod_for_screen_error`] evaluate, rearranged; rounding may move a
+/// [`lod_for_screen_error`](crate::lod_for_screen_error) evaluate, rearranged; rounding may move a
 /// group lying on the threshold to either side, and [`select_exhaustive`]
 /// uses the same test.
 #[derive(Debug, Clone, Copy)]
