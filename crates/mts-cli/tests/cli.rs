@@ -221,9 +221,7 @@ fn render_scene_reports_shared_buckets_by_screen_error() {
         ])
     };
     let (ok, out, err) = run("0");
-    let gpu_required = std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w == "gpu"));
-    if !ok && !gpu_required && err.contains("adapter") {
-        eprintln!("skipped: no graphics adapter ({err})");
+    if common::skipped_without_adapter(ok, &err) {
         return;
     }
     assert!(ok, "{err}");

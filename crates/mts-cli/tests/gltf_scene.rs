@@ -147,10 +147,7 @@ fn scene_file(dir: &Path, meshes: usize, nodes: usize) -> PathBuf {
 /// message) when there is no adapter and `MTS_REQUIRE` does not name gpu.
 fn render(args: &[&str]) -> Option<Value> {
     let (ok, out, err) = mts(&[&["render"][..], args, &["--json"]].concat());
-    let gpu_required =
-        std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w.trim() == "gpu"));
-    if !ok && !gpu_required && err.contains("adapter") {
-        eprintln!("skipped: no graphics adapter ({err})");
+    if common::skipped_without_adapter(ok, &err) {
         return None;
     }
     assert!(ok, "{err}");

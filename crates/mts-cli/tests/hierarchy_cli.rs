@@ -204,9 +204,7 @@ fn bench_view_dependent_compares_the_four_methods() {
         "160x90",
         "--json",
     ]);
-    let gpu_required = std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w == "gpu"));
-    if !ok && !gpu_required && err.contains("adapter") {
-        eprintln!("skipped: no graphics adapter ({err})");
+    if common::skipped_without_adapter(ok, &err) {
         return;
     }
     assert!(ok, "{err}");
@@ -288,9 +286,7 @@ fn bench_render_draws_a_hierarchy_along_the_flight() {
         "160x90",
         "--json",
     ]);
-    let gpu_required = std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w == "gpu"));
-    if !ok && !gpu_required && err.contains("adapter") {
-        eprintln!("skipped: no graphics adapter ({err})");
+    if common::skipped_without_adapter(ok, &err) {
         return;
     }
     assert!(ok, "{err}");

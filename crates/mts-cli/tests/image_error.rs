@@ -26,9 +26,7 @@ fn scene_at(px: &str) -> Option<serde_json::Value> {
         "160x120",
         "--json",
     ]);
-    let gpu_required = std::env::var("MTS_REQUIRE").is_ok_and(|v| v.split(',').any(|w| w == "gpu"));
-    if !ok && !gpu_required && err.contains("adapter") {
-        eprintln!("skipped: no graphics adapter ({err})");
+    if common::skipped_without_adapter(ok, &err) {
         return None;
     }
     assert!(ok, "{err}");

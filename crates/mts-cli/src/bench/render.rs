@@ -55,16 +55,35 @@ pub struct BenchRenderArgs {
     json: bool,
 }
 
+/// The adapter a `--json` report names (its keys flattened into the
+/// report's).
+#[derive(Serialize)]
+pub struct AdapterFields {
+    adapter: String,
+    backend: String,
+    device_type: String,
+    strip_mode: String,
+}
+
+impl AdapterFields {
+    pub fn of(report: &mts_render::AdapterReport) -> AdapterFields {
+        AdapterFields {
+            adapter: report.name.clone(),
+            backend: format!("{:?}", report.backend),
+            device_type: format!("{:?}", report.device_type),
+            strip_mode: report.strip_mode.to_string(),
+        }
+    }
+}
+
 /// What `--json` prints.
 #[derive(Serialize)]
 struct RenderReport {
     scene: Option<Scene>,
     vertex_work: VertexWork,
     input: String,
-    adapter: String,
-    backend: String,
-    device_type: String,
-    strip_mode: String,
+    #[serde(flatten)]
+    adapter: AdapterFields,
     width: u32,
     height: u32,
     frames: usize,
@@ -287,10 +306,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<()> {
             scene,
             vertex_work: vertex,
             input: name,
-            adapter: report.name,
-            backend: format!("{:?}", report.backend),
-            device_type: format!("{:?}", report.device_type),
-            strip_mode: report.strip_mode.to_string(),
+            adapter: AdapterFields::of(&report),
             width: args.size.0,
             height: args.size.1,
             frames: args.frames,

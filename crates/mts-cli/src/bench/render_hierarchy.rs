@@ -4,6 +4,7 @@
 //! as a meshoptimizer-ordered list, frame time side by side, and the cost
 //! of one camera step (selection, walks and the dirty ranges' upload).
 
+use super::render::AdapterFields;
 use super::view_dependent::camera_at;
 use crate::stdout::outln;
 use anyhow::{Context, Result};
@@ -22,10 +23,8 @@ const FRAMES_PER_CAMERA: usize = 2;
 struct HierarchyRenderReport {
     hierarchy: bool,
     input: String,
-    adapter: String,
-    backend: String,
-    device_type: String,
-    strip_mode: String,
+    #[serde(flatten)]
+    adapter: AdapterFields,
     width: u32,
     height: u32,
     /// Cameras along the flight.
@@ -173,10 +172,7 @@ pub fn bench_render_hierarchy(b: &HierarchyBench<'_>) -> Result<()> {
         let out = HierarchyRenderReport {
             hierarchy: true,
             input: b.name.to_string(),
-            adapter: report.name,
-            backend: format!("{:?}", report.backend),
-            device_type: format!("{:?}", report.device_type),
-            strip_mode: report.strip_mode.to_string(),
+            adapter: AdapterFields::of(&report),
             width: b.width,
             height: b.height,
             cameras: b.cameras,
