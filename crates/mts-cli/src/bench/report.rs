@@ -748,12 +748,16 @@ mod tests {
         let results = crate::bench::results::Results::load(&dir.join("results.json")).unwrap();
         let mut text = report(&results);
         let _ = writeln!(text, "\n## Charts\n");
-        for name in [
+        let mut names = vec![
             "indices",
             "figure6_immediate",
             "figure6_per_second",
             "scale",
-        ] {
+        ];
+        if !results.view_dependent.is_empty() {
+            names.push("view_dependent");
+        }
+        for name in names {
             let _ = writeln!(text, "![{name}.png]({name}.png)\n");
         }
         let committed = std::fs::read_to_string(dir.join("report.md")).unwrap();
