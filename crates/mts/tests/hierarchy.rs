@@ -626,3 +626,17 @@ fn build_reports_its_progress_group_by_group() {
     let plain = hierarchy::build(&mesh, &options).unwrap();
     assert_eq!(plain.to_bytes(), h.to_bytes());
 }
+
+/// `verify_groups`: one report per group, in group order, each at the LoDs
+/// asked for its model, none with a mismatch.
+#[test]
+fn every_group_verifies_on_every_core() {
+    let mesh = "terrain:20k".parse::<Generated>().unwrap().build();
+    let h = hierarchy::build(&mesh, &HierarchyOptions::default()).unwrap();
+    let reports = h.verify_groups(|max_lod| vec![0, max_lod / 2, max_lod]);
+    assert_eq!(reports.len(), h.groups().len());
+    for (g, r) in h.groups().iter().zip(&reports) {
+        assert_eq!(r.mismatches, 0, "{:?}", r.first_mismatch);
+        assert_eq!(r.lods_checked, 3, "max LoD {}", g.model.max_lod());
+    }
+}

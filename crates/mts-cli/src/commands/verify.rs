@@ -142,34 +142,11 @@ fn verify_hierarchy(args: &VerifyArgs, path: &Path) -> Result<()> {
         bail!("{name}: {e}");
     }
     // Every group's model, on all cores.
-    let groups = h.groups();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, std::num::NonZeroUsize::get)
-        .min(groups.len())
-        .max(1);
-    let mut reports: Vec<(usize, mts::model::VerifyReport)> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut out = Vec::new();
-                    loop {
-                        let g = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(group) = groups.get(g) else { break };
-                        let model = &group.model;
-                        let lods = spread(model.max_lod(), requested);
-                        out.push((g, mts::model::verify(model, &model.mesh(), &lods)));
-                    }
-                    out
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
-    });
-    reports.sort_unstable_by_key(|(g, _)| *g);
+    let reports: Vec<(usize, mts::model::VerifyReport)> = h
+        .verify_groups(|max_lod| spread(max_lod, requested))
+        .into_iter()
+        .enumerate()
+        .collect();
     let lods_checked: usize = reports.iter().map(|(_, r)| r.lods_checked).sum();
     let mismatches: usize = reports.iter().map(|(_, r)| r.mismatches).sum();
     let first_mismatch = reports.iter().find_map(|(g, r)| {
@@ -207,7 +184,7 @@ fn verify_hierarchy(args: &VerifyArgs, path: &Path) -> Result<()> {
             json!({
                 "input": name,
                 "kind": "hierarchy",
-                "groups_checked": groups.len(),
+                "groups_checked": reports.len(),
                 "lods_checked": lods_checked,
                 "mismatches": mismatches,
                 "first_mismatch": first_mismatch.as_ref().map(|(g, l, what)| json!({"group": g, "lod": l, "what": what})),
@@ -221,7 +198,7 @@ fn verify_hierarchy(args: &VerifyArgs, path: &Path) -> Result<()> {
     } else {
         outln!(
             "{name}: a hierarchy of {} groups: {lods_checked} LoDs checked against the replay oracle and from-scratch extraction, {mismatches} mismatches; {cuts} cuts ({} to {} triangles, {} cameras at {:?} px), {cracks} cracks; {secs:.2} s",
-            groups.len(),
+            reports.len(),
             fewest.min(most),
             most,
             cuts / THRESHOLDS.len(),

@@ -197,6 +197,26 @@ pub struct Hierarchy {
 }
 
 impl Hierarchy {
+    /// [`crate::model::verify`] of every group's model (its strips against
+    /// its replayed triangles) at the LoDs `lods(max_lod)` gives for it
+    /// (ascending), the groups on every core; the reports in group order.
+    ///
+    /// Cost: the groups' verifications, spread over the cores.
+    #[must_use]
+    pub fn verify_groups(
+        &self,
+        lods: impl Fn(usize) -> Vec<usize> + Sync,
+    ) -> Vec<crate::model::VerifyReport> {
+        crate::parallel::map_indexed(
+            self.groups.len(),
+            || (),
+            |(), g| {
+                let model = &self.groups[g].model;
+                crate::model::verify(model, &model.mesh(), &lods(model.max_lod()))
+            },
+        )
+    }
+
     /// The groups, children before parents (by level).
     #[must_use]
     pub fn groups(&self) -> &[Group] {
