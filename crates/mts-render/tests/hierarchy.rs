@@ -30,7 +30,7 @@ use mts_render::{
     Camera, FrameStats, Gpu, HierarchyFrame, HierarchyInstanceId, HierarchyRenderer, Image,
     InstancedScene, RendererConfig, Shading, StripMode,
 };
-use support::{default_gpu, gpu_on};
+use support::{default_gpu, difference, gpu_on};
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
@@ -57,18 +57,6 @@ fn cameras(aspect: f32) -> Vec<Camera> {
     .into_iter()
     .map(|(eye, target)| Camera::looking(eye, target, aspect, 0.005, 12.0))
     .collect()
-}
-
-/// Pixels that differ, and the largest channel difference.
-fn difference(a: &Image, b: &Image) -> (usize, u8) {
-    let max = a
-        .rgba
-        .iter()
-        .zip(&b.rgba)
-        .map(|(x, y)| x.abs_diff(*y))
-        .max()
-        .unwrap_or(0);
-    (a.differing_pixels(b), max)
 }
 
 /// The first `count` indices of `buffer` (restarts as `u32::MAX`).

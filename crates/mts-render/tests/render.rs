@@ -23,7 +23,7 @@ use mts_render::{
     Camera, FrameStats, Gpu, Image, InstanceId, InstancedScene, ModelId, RendererConfig, Shading,
     StripMode, StripRenderer,
 };
-use support::{gpu_on, required_gpu};
+use support::{difference, gpu_on, required_gpu};
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
@@ -92,18 +92,6 @@ impl<'g> Scene<'g> {
             })
             .unwrap()
     }
-}
-
-/// Pixels that differ, and the largest channel difference.
-fn difference(a: &Image, b: &Image) -> (usize, u8) {
-    let max = a
-        .rgba
-        .iter()
-        .zip(&b.rgba)
-        .map(|(x, y)| x.abs_diff(*y))
-        .max()
-        .unwrap_or(0);
-    (a.differing_pixels(b), max)
 }
 
 /// The strips at each LoD of `ratios` against the oracle list, and the

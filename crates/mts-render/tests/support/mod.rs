@@ -44,3 +44,16 @@ pub fn default_gpu() -> Option<Gpu> {
         Err(e) => panic!("GPU setup failed: {e}"),
     }
 }
+
+/// Pixels that differ, and the largest channel difference.
+#[allow(dead_code)] // not every test file compares images
+pub fn difference(a: &mts_render::headless::Image, b: &mts_render::headless::Image) -> (usize, u8) {
+    let max = a
+        .rgba
+        .iter()
+        .zip(&b.rgba)
+        .map(|(x, y)| x.abs_diff(*y))
+        .max()
+        .unwrap_or(0);
+    (a.differing_pixels(b), max)
+}
