@@ -246,6 +246,7 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
             b.raw > 0
                 && b.raw_u16 > 0
                 && b.mts_file > 0
+                && b.mts_file < b.mts_file_uncompressed
                 && b.mts_recipe_file > 0
                 && b.mts_memory > 0,
             at("bytes: a size is 0"),

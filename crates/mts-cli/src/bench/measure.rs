@@ -624,7 +624,9 @@ fn measure_model(
 ) -> Result<(Model, MtsModel)> {
     let (model, _, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-    let file_bytes = model.to_bytes().len();
+    let file_bytes = model
+        .to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL)
+        .len();
     let stats = model.stats();
     // Struct fields are evaluated as written: the sections run in this
     // order.
@@ -639,6 +641,7 @@ fn measure_model(
             raw: model.raw_bytes() as u64,
             raw_u16: model.raw_bytes_u16() as u64,
             mts_file: file_bytes as u64,
+            mts_file_uncompressed: model.to_bytes().len() as u64,
             mts_recipe_file: model.to_recipe_bytes().len() as u64,
             mts_memory: stats.memory_bytes as u64,
         },
@@ -808,12 +811,16 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Result<Scale> {
         let (model_bytes, rss) = (model.stats().memory_bytes, peak_rss());
         drop(ex);
         let file = model.to_bytes();
+        let coded = model.to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL);
         drop(model);
-        let load_ms = time_us(3, || {
-            let m = mts::MtsModel::from_bytes(&file, std::path::Path::new("scale.mts"))
-                .expect("a file just written loads");
-            std::hint::black_box(Extractor::new(&m).buffer().len());
-        }) / 1e3;
+        let load = |bytes: &[u8]| {
+            time_us(3, || {
+                let m = mts::MtsModel::from_bytes(bytes, std::path::Path::new("scale.mts"))
+                    .expect("a file just written loads");
+                std::hint::black_box(Extractor::new(&m).buffer().len());
+            }) / 1e3
+        };
+        let (load_ms, coded_load_ms) = (load(&file), load(&coded));
         // Each stage alone (the pipeline runs stripify beside simplify),
         // against meshoptimizer, one run each.
         let ((_, stripify_ms), (_, meshopt_stripify_ms)) = interleaved_ms(
@@ -837,6 +844,8 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Result<Scale> {
             model_bytes: model_bytes as u64,
             file_bytes: file.len() as u64,
             load_ms,
+            coded_file_bytes: coded.len() as u64,
+            coded_load_ms,
             extract_lod0_us: extract_us,
             peak_rss_bytes: rss
                 .context("cannot read the peak memory (VmHWM of /proc/self/status)")?,

@@ -270,12 +270,12 @@ pub fn figure6_row<'r>(
 /// README's).
 pub fn scale_table(s: &mut String, scale: &Scale) {
     let _ = writeln!(s, "Stripify and simplify (whole sequence) each timed alone, beside meshoptimizer's `stripify` and `simplify` to 10%; build is the whole pipeline (stripify beside simplify, then the model).\n");
-    let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes (per triangle) | .mts bytes | load ms (parse, validate, extractor ready) | peak RSS bytes (process so far) | LoD 0 extraction µs |");
+    let _ = writeln!(s, "| triangles | stripify ms (mts / meshopt) | simplify ms (mts whole / meshopt to 10%) | build ms | model bytes (per triangle) | .mts bytes, coded / uncoded | load ms (decode, parse, validate, extractor ready), coded / uncoded | peak RSS bytes (process so far) | LoD 0 extraction µs |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
     for r in &scale.rows {
         let _ = writeln!(
             s,
-            "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} ({:.1}) | {} | {:.1} | {} | {:.0} |",
+            "| {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {} ({:.1}) | {} / {} | {:.1} / {:.1} | {} | {:.0} |",
             r.triangles,
             r.stripify_ms,
             r.meshopt_stripify_ms,
@@ -284,7 +284,9 @@ pub fn scale_table(s: &mut String, scale: &Scale) {
             r.build_ms,
             r.model_bytes,
             r.model_bytes as f64 / r.triangles.max(1) as f64,
+            r.coded_file_bytes,
             r.file_bytes,
+            r.coded_load_ms,
             r.load_ms,
             r.peak_rss_bytes,
             r.extract_lod0_us,
@@ -412,17 +414,17 @@ pub fn report(results: &Results) -> String {
         results.command, results.elapsed_s,
     );
     let _ = writeln!(s, "## Table 1: models and sizes (bytes)\n");
-    let _ = writeln!(s, "The `.mts` file holds the model ready to walk (version 3); the recipe-only file (`mts build --recipe-only`) loads by building the graphs again. Memory is the model's arrays with its vertices and their properties.\n");
-    let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | recipe-only .mts / raw | MTS in memory | memory / raw | memory bytes / triangle | build ms (stripify ‖ simplify, model, total) |");
+    let _ = writeln!(s, "The `.mts` file holds the model ready to walk, coded (version 5, what `mts build` writes; uncoded, version 3, beside it); the recipe-only file (`mts build --recipe-only`) loads by building the graphs again. Memory is the model's arrays with its vertices and their properties.\n");
+    let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | uncoded .mts / raw | recipe-only .mts / raw | MTS in memory | memory / raw | memory bytes / triangle | build ms (stripify ‖ simplify, model, total) |");
     let _ = writeln!(
         s,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in models {
         let (b, t) = (&r.bytes, &r.build_ms);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
             r.name,
             r.strips,
             r.triangles,
@@ -433,6 +435,7 @@ pub fn report(results: &Results) -> String {
             b.raw_u16,
             b.mts_file,
             b.mts_file as f64 / b.raw as f64,
+            b.mts_file_uncompressed as f64 / b.raw as f64,
             b.mts_recipe_file as f64 / b.raw as f64,
             b.mts_memory,
             b.mts_memory as f64 / b.raw as f64,

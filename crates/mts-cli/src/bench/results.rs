@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 8;
+pub const SCHEMA_VERSION: u32 = 9;
 
 /// Steps (of 255) an RGB byte may move before an image comparison
 /// (Figure 6's, the scene's, the properties') counts the pixel as changed.
@@ -166,7 +166,11 @@ pub struct Model {
 pub struct Bytes {
     pub raw: u64,
     pub raw_u16: u64,
+    /// The ready `.mts` file `mts build` writes (version 5, coded at
+    /// `mts::model::compress::DEFAULT_LEVEL`).
     pub mts_file: u64,
+    /// The ready file uncoded (version 3, `mts build --uncompressed`).
+    pub mts_file_uncompressed: u64,
     /// The recipe-only `.mts` (`mts build --recipe-only`).
     pub mts_recipe_file: u64,
     pub mts_memory: u64,
@@ -351,10 +355,14 @@ pub struct ScaleRow {
     pub meshopt_simplify_to_10_ms: f64,
     pub build_ms: f64,
     pub model_bytes: u64,
-    /// The ready `.mts` file, and loading it (parse, validate, extractor
-    /// ready; median ms).
+    /// The ready `.mts` file uncoded (version 3), and loading it (parse,
+    /// validate, extractor ready; median ms).
     pub file_bytes: u64,
     pub load_ms: f64,
+    /// The coded file (version 5, `mts build`'s default level) and loading
+    /// it (decode too).
+    pub coded_file_bytes: u64,
+    pub coded_load_ms: f64,
     pub extract_lod0_us: f64,
     pub peak_rss_bytes: u64,
 }

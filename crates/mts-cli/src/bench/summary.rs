@@ -223,10 +223,11 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
         let ratio = b.bytes.mts_file as f64 / b.bytes.raw as f64;
         row(
             s,
-            "bunny: .mts file (ready to walk) against the raw mesh (12 + 12 bytes)",
+            "bunny: .mts file (ready to walk, coded) against the raw mesh (12 + 12 bytes)",
             "≤ 1.5 ×",
             format!(
-                "{ratio:.2} × (recipe only, which loads by building: {:.2} ×)",
+                "{ratio:.2} × (uncoded: {:.2} ×; recipe only, which loads by building: {:.2} ×)",
+                b.bytes.mts_file_uncompressed as f64 / b.bytes.raw as f64,
                 b.bytes.mts_recipe_file as f64 / b.bytes.raw as f64
             ),
             ratio <= 1.5,
@@ -246,7 +247,7 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
         if let Some(load) = load {
             row(
                 s,
-                "bunny: load (file bytes parsed, validated, extractor ready)",
+                "bunny: load of the coded file (decoded, parsed, validated, extractor ready)",
                 "< 10 ms",
                 format!("{load:.1} ms"),
                 load < 10.0,
@@ -360,10 +361,16 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
         );
         row(
             s,
-            &format!("{t:.0}-triangle icosphere: load (parse, validate, extractor ready)"),
+            &format!(
+                "{t:.0}-triangle icosphere: load of the coded file (decode, parse, validate, \
+                 extractor ready)"
+            ),
             "< 150 ms",
-            format!("{:.0} ms", r.load_ms),
-            r.load_ms < 150.0,
+            format!(
+                "{:.0} ms (uncoded file: {:.0} ms)",
+                r.coded_load_ms, r.load_ms
+            ),
+            r.coded_load_ms < 150.0,
         );
     }
     if let Some(scale) = &results.scale {

@@ -530,6 +530,8 @@ fn decode_group(mut r: Reader<'_>, g: usize, c: &Context<'_>) -> Result<Group> {
             step,
             cmpn: Some(cmpn),
             modl: Some(modl),
+            modl_coded: false,
+            arrays: None,
         },
         c.file,
         false,

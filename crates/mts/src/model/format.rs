@@ -57,6 +57,12 @@
 //! its groups' models in the sections above ([`crate::hierarchy::format`]):
 //! [`MtsModel::from_bytes`] says so when given one, and [`holds`] tells
 //! the two kinds apart from the header.
+//!
+//! Version 5 ([`COMPRESSED_VERSION`], what `mts build` writes) is version 3
+//! with each section's payload coded with Zstandard, `MODL` in five
+//! columns ([`super::compress`]): about a third of version 3's bytes (the
+//! bunny: 2.4 MB against 7.2 MB, 1.9 × the raw mesh), decoded and then
+//! checked exactly as version 3.
 
 use super::records::Narrow;
 use super::{build, BuildOptions, MtsModel};
@@ -69,8 +75,13 @@ use std::path::{Path, PathBuf};
 
 /// The file's first bytes.
 pub const MAGIC: &[u8; 8] = b"MTSMODEL";
-/// The version this crate writes; it reads 1 and 2 too.
+/// The version of the ready file with its arrays as they lie in memory
+/// ([`MtsModel::to_bytes`]); this crate reads 1, 2 and
+/// [`COMPRESSED_VERSION`] too.
 pub const VERSION: u32 = 3;
+/// The version of a model file whose sections are coded
+/// ([`MtsModel::to_compressed_bytes`], [`super::compress`]).
+pub const COMPRESSED_VERSION: u32 = 5;
 const HEADER_LEN: usize = 32;
 const TAGS: [&[u8; 4]; 7] = [
     b"META", b"POSI", b"STRP", b"STEP", b"PROP", b"CMPN", b"MODL",
@@ -122,7 +133,7 @@ pub fn file_version(bytes: &[u8]) -> Option<u32> {
 #[must_use]
 pub fn holds(bytes: &[u8]) -> Option<Holds> {
     match file_version(bytes)? {
-        1..=VERSION => Some(Holds::Model),
+        1..=VERSION | COMPRESSED_VERSION => Some(Holds::Model),
         crate::hierarchy::format::VERSION => Some(Holds::Hierarchy),
         _ => None,
     }
@@ -177,6 +188,22 @@ impl MtsModel {
     #[must_use]
     pub fn to_recipe_bytes(&self) -> Vec<u8> {
         self.encode(false)
+    }
+
+    /// The model as `.mts` bytes ready to walk, its sections coded with
+    /// Zstandard at `level` (1 to 22; [`super::compress::DEFAULT_LEVEL`]
+    /// in `mts build`): version [`COMPRESSED_VERSION`], about a third of
+    /// [`MtsModel::to_bytes`] on the bunny, loaded in a few more
+    /// milliseconds (see [`super::compress`]). [`MtsModel::from_bytes`]
+    /// reads it.
+    #[must_use]
+    pub fn to_compressed_bytes(&self, level: i32) -> Vec<u8> {
+        let recipe = self.payloads(2);
+        let payloads = super::compress::pack(&recipe, &self.model_parts(true), level);
+        let mut body = Vec::new();
+        let sections = payloads.len();
+        put_sections(&mut body, TAGS.iter().copied().zip(payloads));
+        seal_body(COMPRESSED_VERSION, sections, &body)
     }
 
     fn encode(&self, ready: bool) -> Vec<u8> {
@@ -276,7 +303,18 @@ impl MtsModel {
 
     /// The `MODL` section.
     fn model_payload(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(self.stats().memory_bytes);
+        self.model_parts(false).concat()
+    }
+
+    /// The `MODL` section in five parts, whose concatenation is the
+    /// section: the counts, widths and `u32` arrays before the records;
+    /// the records' vertices (with `node_vertices_only`, only those of the
+    /// records that start a node, as version 5 codes them:
+    /// [`super::compress`]); their labels; their codes; the far arcs and the
+    /// LoD → triangle table.
+    pub(crate) fn model_parts(&self, node_vertices_only: bool) -> [Vec<u8>; 5] {
+        let mut head =
+            Vec::with_capacity(64 + 4 * (3 * self.strip_count() + 2 * self.begin_node.len()));
         for n in [
             self.strip_count(),
             self.band_count(),
@@ -284,10 +322,10 @@ impl MtsModel {
             self.rec_code.len(),
             self.far.len(),
         ] {
-            put_varint(&mut out, n as u64);
+            put_varint(&mut head, n as u64);
         }
-        out.push(self.rec_vertex.width() as u8);
-        out.push(self.rec_label.width() as u8);
+        head.push(self.rec_vertex.width() as u8);
+        head.push(self.rec_label.width() as u8);
         let words = |out: &mut Vec<u8>, v: &[u32]| {
             for x in v {
                 out.extend_from_slice(&x.to_le_bytes());
@@ -302,26 +340,39 @@ impl MtsModel {
             &self.begin_node,
             &self.begin_res,
         ] {
-            words(&mut out, v);
+            words(&mut head, v);
         }
-        for n in [&self.rec_vertex, &self.rec_label] {
+        let starts_node = |r: usize| r == 0 || self.rec_code[r - 1] & super::records::MORE == 0;
+        let narrow = |n: &Narrow, only_nodes: bool| {
+            let mut out = Vec::with_capacity(n.bytes());
+            let keep = |r: usize| !only_nodes || starts_node(r);
             match n {
                 Narrow::U16(v) => v
                     .iter()
-                    .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
-                Narrow::U32(v) => words(&mut out, v),
+                    .enumerate()
+                    .filter(|&(r, _)| keep(r))
+                    .for_each(|(_, x)| out.extend_from_slice(&x.to_le_bytes())),
+                Narrow::U32(v) => v
+                    .iter()
+                    .enumerate()
+                    .filter(|&(r, _)| keep(r))
+                    .for_each(|(_, x)| out.extend_from_slice(&x.to_le_bytes())),
             }
-        }
-        out.extend_from_slice(&self.rec_code);
+            out
+        };
+        let vertices = narrow(&self.rec_vertex, node_vertices_only);
+        let labels = narrow(&self.rec_label, false);
+        let mut tail = Vec::with_capacity(8 * self.far.len() + 4 * (self.max_lod() + 1));
         for &(r, t) in &self.far {
-            words(&mut out, &[r, t]);
+            words(&mut tail, &[r, t]);
         }
-        words(&mut out, self.recipe.collapses.triangle_counts());
-        out
+        words(&mut tail, self.recipe.collapses.triangle_counts());
+        [head, vertices, labels, self.rec_code.clone(), tail]
     }
 
-    /// Writes the model to `path`, ready to walk (see
-    /// [`MtsModel::to_bytes`]), whole or not at all ([`crate::output`]).
+    /// Writes the model to `path`, ready to walk with its arrays uncoded
+    /// (see [`MtsModel::to_bytes`]; [`MtsModel::to_compressed_bytes`] for
+    /// the coded file), whole or not at all ([`crate::output`]).
     ///
     /// # Errors
     /// [`Error::Io`] if the file cannot be written.
@@ -347,9 +398,56 @@ impl MtsModel {
     /// naming the byte offset and section of the first problem otherwise
     /// (truncation, checksum, counts, indices, labels).
     pub fn from_bytes(bytes: &[u8], file: &Path) -> Result<MtsModel> {
+        if file_version(bytes) == Some(COMPRESSED_VERSION) {
+            return read_coded_model(bytes, file);
+        }
         let sections = model_sections(bytes, file)?;
         read_model(sections, file, true)
     }
+}
+
+/// Reads a version-5 file ([`super::compress`]): its header, what its
+/// parts may decode to, then the `MODL` arrays decoded on a second thread
+/// (from as soon as the step count is known) while the recipe's sections
+/// are decoded and parsed; then as version 3.
+fn read_coded_model(bytes: &[u8], file: &Path) -> Result<MtsModel> {
+    use super::compress::{check_expansion, only_part, unpack_recipe};
+    let (_, mut top) = check_header(bytes, file, Holds::Model, section_count)?;
+    let mut coded = split_sections(&mut top, &TAGS)?;
+    top.finish()?;
+    check_expansion(&coded, bytes.len())?;
+    let Some(modl) = coded.pop() else {
+        return Err(top.error("no MODL section"));
+    };
+    // The step count (META's fifth varint), bounded as `parse_model`
+    // bounds it (6 bytes a step at least); a wrong one fails there first.
+    let (r, meta) = only_part(&coded[0])?;
+    let meta = meta.decode(&r)?;
+    let mut m = Reader::new(&meta, 0, "META, decoded", file);
+    for _ in 0..4 {
+        m.varint()?;
+    }
+    let step_bytes = only_part(&coded[3])?.1.decoded_len();
+    let steps = m.count("step count", step_bytes / 6)?;
+    std::thread::scope(|scope| {
+        let arrays_of = modl.clone();
+        let arrays = scope.spawn(move || read_coded_arrays(arrays_of, steps));
+        let recipe = unpack_recipe(coded)?;
+        let mut readers: Vec<Reader<'_>> = recipe
+            .iter()
+            .zip(DECODED_NAMES)
+            .map(|(d, name)| Reader::new(d, 0, name, file))
+            .collect();
+        readers.push(modl);
+        let mut sections = sections_of(readers, file)?;
+        sections.modl_coded = true;
+        sections.arrays = Some(Box::new(move || {
+            arrays
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e))
+        }));
+        read_model(sections, file, true)
+    })
 }
 
 /// Decodes one model's sections and checks it: a recipe (no `MODL`) is
@@ -600,21 +698,21 @@ pub(crate) fn check_header<'a>(
     let version = u32_at(8);
     let hierarchy = crate::hierarchy::format::VERSION;
     let wrong = match (holds, version) {
-        (Holds::Model, 1..=VERSION) => None,
+        (Holds::Model, 1..=VERSION | COMPRESSED_VERSION) => None,
         (Holds::Hierarchy, v) if v == hierarchy => None,
         (Holds::Model, v) if v == hierarchy => Some(format!(
             "byte 8: .mts version {v} holds a view-dependent hierarchy (`mts build \
              --hierarchy`), not a per-object model: `mts info` and `mts verify` read it (in \
              the library: mts::hierarchy::Hierarchy::load)"
         )),
-        (Holds::Hierarchy, v @ 1..=VERSION) => Some(format!(
+        (Holds::Hierarchy, v @ (1..=VERSION | COMPRESSED_VERSION)) => Some(format!(
             "byte 8: .mts version {v} holds a per-object model, not a view-dependent \
              hierarchy (version {hierarchy}): `mts build --hierarchy` writes one (in the \
              library: mts::MtsModel::load reads this file)"
         )),
         (_, v) => Some(format!(
-            "byte 8: .mts version {v}; this build reads versions 1 to {VERSION} (a model) \
-             and {hierarchy} (a hierarchy)"
+            "byte 8: .mts version {v}; this build reads versions 1 to {VERSION} and \
+             {COMPRESSED_VERSION} (a model) and {hierarchy} (a hierarchy)"
         )),
     };
     if let Some(message) = wrong {
@@ -705,7 +803,15 @@ pub(crate) struct ModelSections<'a> {
     pub(crate) step: Reader<'a>,
     pub(crate) cmpn: Option<Reader<'a>>,
     pub(crate) modl: Option<Reader<'a>>,
+    /// Whether `modl` is coded (version 5, [`super::compress`]).
+    pub(crate) modl_coded: bool,
+    /// The arrays of `modl`, being read elsewhere: called once the recipe
+    /// is parsed (version 5 starts them before the recipe is decoded).
+    pub(crate) arrays: Option<ArraysJoin<'a>>,
 }
+
+/// What [`ModelSections::arrays`] holds.
+pub(crate) type ArraysJoin<'a> = Box<dyn FnOnce() -> Result<Arrays> + 'a>;
 
 /// Where a model's vertices come from.
 pub(crate) enum Vertices<'a> {
@@ -726,8 +832,25 @@ pub(crate) enum Vertices<'a> {
 /// The sections of a model file (versions 1 to 3), its header checked.
 fn model_sections<'a>(bytes: &'a [u8], file: &Path) -> Result<ModelSections<'a>> {
     let (version, mut top) = check_header(bytes, file, Holds::Model, section_count)?;
-    let mut sections = split_sections(&mut top, &TAGS[..section_count(version)])?;
+    let sections = split_sections(&mut top, &TAGS[..section_count(version)])?;
     top.finish()?;
+    sections_of(sections, file)
+}
+
+/// The names of a version-5 file's sections once decoded (an error's byte
+/// is then an offset in the decoded section).
+const DECODED_NAMES: [&str; 6] = [
+    "META, decoded",
+    "POSI, decoded",
+    "STRP, decoded",
+    "STEP, decoded",
+    "PROP, decoded",
+    "CMPN, decoded",
+];
+
+/// A model's sections from readers over them, in the order of [`TAGS`]
+/// (the first four at least).
+fn sections_of<'a>(mut sections: Vec<Reader<'a>>, file: &Path) -> Result<ModelSections<'a>> {
     let mut extra = sections.split_off(V1_SECTIONS).into_iter();
     let (prop, cmpn, modl) = (extra.next(), extra.next(), extra.next());
     let [meta, posi, strp, step]: [Reader; 4] = sections
@@ -740,6 +863,8 @@ fn model_sections<'a>(bytes: &'a [u8], file: &Path) -> Result<ModelSections<'a>>
         step,
         cmpn,
         modl,
+        modl_coded: false,
+        arrays: None,
     })
 }
 
@@ -753,6 +878,8 @@ fn parse_model(s: ModelSections<'_>, threaded: bool) -> Result<Parsed<'_>> {
         mut step,
         cmpn,
         modl,
+        modl_coded,
+        arrays: prefetched,
     } = s;
     // META: counts, each bounded by the bytes of the section that holds it.
     let (vertices, appended) = match &source {
@@ -827,11 +954,21 @@ fn parse_model(s: ModelSections<'_>, threaded: bool) -> Result<Parsed<'_>> {
 
     // The model's arrays are read on a second thread while the recipe is
     // parsed (version 3), when `threaded`.
+    // A coded section (version 5) is decoded there too.
     let arrays_reader = modl.clone();
+    let arrays_of = move |m: Reader<'_>| {
+        if modl_coded {
+            read_coded_arrays(m, steps)
+        } else {
+            read_arrays(m, steps)
+        }
+    };
     std::thread::scope(|scope| {
-        let (reading, inline) = if threaded {
+        let (reading, inline) = if prefetched.is_some() {
+            (None, None)
+        } else if threaded {
             (
-                arrays_reader.map(|m| scope.spawn(move || read_arrays(m, steps))),
+                arrays_reader.map(|m| scope.spawn(move || arrays_of(m))),
                 None,
             )
         } else {
@@ -968,7 +1105,15 @@ fn parse_model(s: ModelSections<'_>, threaded: bool) -> Result<Parsed<'_>> {
             // Version 3 stores the triangle counts with the model (read and
             // checked by `read_model`); earlier versions replay them.
             let counts = if let Some(m) = &modl {
-                table_at_end(m, list.len() + 1, strips.triangle_count() as u32)?
+                let lods = list.len() + 1;
+                let triangles = strips.triangle_count() as u32;
+                if modl_coded {
+                    let tail = super::compress::modl_tail(m.clone())?;
+                    let t = Reader::new(&tail, 0, "MODL tail, decoded", &m.file);
+                    table_at_end(&t, lods, triangles)?
+                } else {
+                    table_at_end(m, lods, triangles)?
+                }
             } else {
                 replay_counts(&mesh, &list, optimal, &companions)
             };
@@ -995,7 +1140,9 @@ fn parse_model(s: ModelSections<'_>, threaded: bool) -> Result<Parsed<'_>> {
         })();
         let arrays = reading.map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
         rest.map(|mut p| {
-            p.arrays = arrays.or_else(|| inline.map(|m| read_arrays(m, steps)));
+            p.arrays = arrays
+                .or_else(|| prefetched.map(|join| join()))
+                .or_else(|| inline.map(arrays_of));
             p
         })
     })
@@ -1005,7 +1152,7 @@ fn parse_model(s: ModelSections<'_>, threaded: bool) -> Result<Parsed<'_>> {
 /// is bounded by the bytes left before anything is allocated; the
 /// structure is checked afterwards by [`MtsModel::validate`].
 /// The graph arrays of the `MODL` section, before they join the recipe.
-struct Arrays {
+pub(crate) struct Arrays {
     strip_records: Vec<u32>,
     strip_begins: Vec<u32>,
     begin_node: Vec<u32>,
@@ -1024,40 +1171,8 @@ struct Arrays {
 /// is allocated; the structure is checked afterwards by
 /// [`MtsModel::validate`].
 fn read_arrays(mut r: Reader<'_>, max_lod: usize) -> Result<Arrays> {
-    let left = r.remaining() as u64;
-    let strips = r.count("strip count", left / 12)?;
-    let bands = r.count("band count", left / 8)?;
-    let begins = r.count("beginning count", left / 8)?;
-    let records = r.count("record count", left / 3)?;
-    let far = r.count("far arc count", left / 8)?;
-    let mut width = |what: &str| -> Result<usize> {
-        match r.u8()? {
-            w @ (2 | 4) => Ok(usize::from(w)),
-            w => {
-                r.pos -= 1;
-                Err(r.error(format!("{what} width {w}, not 2 or 4")))
-            }
-        }
-    };
-    let (vertex_width, label_width) = (width("vertex")?, width("label")?);
-    let needed = 4 * (2 * bands + 1 + 3 * (strips + 1) + 2 * begins + 2 * far + max_lod + 1) as u64
-        - 4
-        + ((vertex_width + label_width + 1) * records) as u64;
-    if needed != r.remaining() as u64 {
-        return Err(r.error(format!(
-            "{} bytes for {strips} strips, {bands} bands, {begins} beginnings, {records} records, \
-             {far} far arcs and {} LoDs; {needed} expected",
-            r.remaining(),
-            max_lod + 1
-        )));
-    }
-    let band_lod = r.words(bands)?;
-    let band_strips = r.words(bands + 1)?;
-    let strip_records = r.words(strips + 1)?;
-    let strip_begins = r.words(strips + 1)?;
-    let slot_size = r.words(strips)?;
-    let begin_node = r.words(begins)?;
-    let begin_res = r.words(begins)?;
+    let head = read_head(&mut r, max_lod, None)?;
+    let records = head.records;
     let mut narrow = |width: usize| -> Result<Narrow> {
         Ok(if width == 2 {
             Narrow::U16(
@@ -1070,27 +1185,213 @@ fn read_arrays(mut r: Reader<'_>, max_lod: usize) -> Result<Arrays> {
             Narrow::U32(r.words(records)?)
         })
     };
-    let rec_vertex = narrow(vertex_width)?;
-    let rec_label = narrow(label_width)?;
+    let rec_vertex = narrow(head.vertex_width)?;
+    let rec_label = narrow(head.label_width)?;
     let rec_code = r.take(records)?.to_vec();
+    let far = read_far(&mut r, head.far, max_lod)?;
+    Ok(head.with_records(rec_vertex, rec_label, rec_code, far))
+}
+
+/// The arrays of a version-5 `MODL` section `m` (see [`super::compress`]):
+/// the head decoded and checked first, then the records' columns decoded
+/// straight into their arrays (the vertices on a second thread), each
+/// part's length checked against the head's counts, and the vertices of the
+/// records that start a node spread back over every record (0 on a node's
+/// later records).
+fn read_coded_arrays(mut m: Reader<'_>, max_lod: usize) -> Result<Arrays> {
+    use super::compress::modl_parts;
+    let parts = modl_parts(&mut m)?;
+    let m = &m;
+    let [head, vertices, labels, codes, tail] = &parts[..] else {
+        return Err(m.error("part count"));
+    };
+    let head_bytes = head.decode(m)?;
+    let mut h = Reader::new(&head_bytes, 0, "MODL head, decoded", &m.file);
+    let head = read_head(
+        &mut h,
+        max_lod,
+        Some((codes.decoded_len(), tail.decoded_len())),
+    )?;
+    let records = head.records;
+    let (vw, lw) = (head.vertex_width, head.label_width);
+    // The vertices' part holds those of the node starts, counted below.
+    let stored = usize::try_from(vertices.decoded_len()).unwrap_or(usize::MAX) / vw;
+    if stored > records {
+        return Err(m.error(format!(
+            "vertices: {} bytes for at most {records} nodes of {vw} bytes",
+            vertices.decoded_len()
+        )));
+    }
+    fn spread<T: Copy + Default>(v: &mut [T], codes: &[u8], stored: usize) -> bool {
+        // Backwards, so that a value moves to its record (never before its
+        // own index) before that index is written; a select, not a branch.
+        let (mut k, mut short) = (stored, false);
+        for r in (0..v.len()).rev() {
+            let s = r == 0 || codes[r - 1] & super::records::MORE == 0;
+            short |= s && k == 0;
+            k = k.saturating_sub(usize::from(s));
+            let x = v[k];
+            v[r] = if s { x } else { T::default() };
+        }
+        !short && k == 0
+    }
+    let (rec_vertex, rest) = std::thread::scope(|scope| {
+        let vertex_part = scope.spawn(move || -> Result<Narrow> {
+            Ok(if vw == 2 {
+                let mut v = vec![0u16; records];
+                vertices.decode_into(m, &mut v[..stored], u16::from_le)?;
+                Narrow::U16(v)
+            } else {
+                let mut v = vec![0u32; records];
+                vertices.decode_into(m, &mut v[..stored], u32::from_le)?;
+                Narrow::U32(v)
+            })
+        });
+        let rest = (|| -> Result<(Narrow, Vec<u8>, Vec<u8>)> {
+            let mut rec_code = vec![0u8; records];
+            codes.decode_into(m, &mut rec_code, u8::from_le)?;
+            let rec_label = if lw == 2 {
+                let mut v = vec![0u16; records];
+                labels.decode_into(m, &mut v, u16::from_le)?;
+                Narrow::U16(v)
+            } else {
+                let mut v = vec![0u32; records];
+                labels.decode_into(m, &mut v, u32::from_le)?;
+                Narrow::U32(v)
+            };
+            Ok((rec_label, rec_code, tail.decode(m)?))
+        })();
+        let v = vertex_part
+            .join()
+            .unwrap_or_else(|e| std::panic::resume_unwind(e));
+        (v, rest)
+    });
+    let (mut rec_vertex, (rec_label, rec_code, tail)) = (rec_vertex?, rest?);
+    let spread_all = match &mut rec_vertex {
+        Narrow::U16(v) => spread(v, &rec_code, stored),
+        Narrow::U32(v) => spread(v, &rec_code, stored),
+    };
+    if !spread_all {
+        return Err(m.error(format!(
+            "vertices: {stored} values for another number of nodes"
+        )));
+    }
+    let mut t = Reader::new(&tail, 0, "MODL tail, decoded", &m.file);
+    let far = read_far(&mut t, head.far, max_lod)?;
+    Ok(head.with_records(rec_vertex, rec_label, rec_code, far))
+}
+
+/// The counts, widths and `u32` arrays that start a `MODL` section.
+struct Head {
+    records: usize,
+    far: usize,
+    vertex_width: usize,
+    label_width: usize,
+    band_lod: Vec<u32>,
+    band_strips: Vec<u32>,
+    strip_records: Vec<u32>,
+    strip_begins: Vec<u32>,
+    slot_size: Vec<u32>,
+    begin_node: Vec<u32>,
+    begin_res: Vec<u32>,
+}
+
+impl Head {
+    fn with_records(
+        self,
+        rec_vertex: Narrow,
+        rec_label: Narrow,
+        rec_code: Vec<u8>,
+        far: Vec<(u32, u32)>,
+    ) -> Arrays {
+        Arrays {
+            strip_records: self.strip_records,
+            strip_begins: self.strip_begins,
+            begin_node: self.begin_node,
+            begin_res: self.begin_res,
+            rec_vertex,
+            rec_label,
+            rec_code,
+            far,
+            slot_size: self.slot_size,
+            band_lod: self.band_lod,
+            band_strips: self.band_strips,
+        }
+    }
+}
+
+/// Reads a `MODL` section's head from `r`. Version 3 (`records` `None`):
+/// the counts must account for every byte of `r`, records and tail
+/// included; version 5 (`coded`: the bytes the codes' and the tail's parts
+/// announce): the head is its own part, the record count must be the
+/// codes' bytes, the far arcs fit the tail, and the other parts are
+/// checked by their reader.
+fn read_head(r: &mut Reader<'_>, max_lod: usize, coded: Option<(u64, u64)>) -> Result<Head> {
+    let records = coded.map(|c| c.0);
+    let left = r.remaining() as u64;
+    let strips = r.count("strip count", left / 12)?;
+    let bands = r.count("band count", left / 8)?;
+    let begins = r.count("beginning count", left / 8)?;
+    let at = r.pos;
+    let record_count = r.count("record count", records.unwrap_or(left / 3))?;
+    if records.is_some_and(|n| n != record_count as u64) {
+        r.pos = at;
+        return Err(r.error(format!(
+            "{record_count} records, {} bytes of codes",
+            records.unwrap_or(0)
+        )));
+    }
+    let far = r.count("far arc count", coded.map_or(left, |c| c.1) / 8)?;
+    let mut width = |what: &str| -> Result<usize> {
+        match r.u8()? {
+            w @ (2 | 4) => Ok(usize::from(w)),
+            w => {
+                r.pos -= 1;
+                Err(r.error(format!("{what} width {w}, not 2 or 4")))
+            }
+        }
+    };
+    let (vertex_width, label_width) = (width("vertex")?, width("label")?);
+    let words = 4 * (2 * bands + 1 + 3 * (strips + 1) + 2 * begins) as u64 - 4;
+    let needed = if records.is_some() {
+        words
+    } else {
+        words
+            + 4 * (2 * far + max_lod + 1) as u64
+            + ((vertex_width + label_width + 1) * record_count) as u64
+    };
+    if needed != r.remaining() as u64 {
+        return Err(r.error(format!(
+            "{} bytes for {strips} strips, {bands} bands, {begins} beginnings, {record_count} \
+             records, {far} far arcs and {} LoDs; {needed} expected",
+            r.remaining(),
+            max_lod + 1
+        )));
+    }
+    Ok(Head {
+        records: record_count,
+        far,
+        vertex_width,
+        label_width,
+        band_lod: r.words(bands)?,
+        band_strips: r.words(bands + 1)?,
+        strip_records: r.words(strips + 1)?,
+        strip_begins: r.words(strips + 1)?,
+        slot_size: r.words(strips)?,
+        begin_node: r.words(begins)?,
+        begin_res: r.words(begins)?,
+    })
+}
+
+/// The far arcs and the LoD → triangle table (read by `parse`,
+/// `table_at_end`) that end a `MODL` section, from `r`, which must end
+/// there.
+fn read_far(r: &mut Reader<'_>, far: usize, max_lod: usize) -> Result<Vec<(u32, u32)>> {
     let far_words = r.words(2 * far)?;
     let far = far_words.chunks_exact(2).map(|p| (p[0], p[1])).collect();
-    // The LoD → triangle table, read by `parse` (`table_at_end`).
     r.take(4 * (max_lod + 1))?;
     r.finish()?;
-    Ok(Arrays {
-        strip_records,
-        strip_begins,
-        begin_node,
-        begin_res,
-        rec_vertex,
-        rec_label,
-        rec_code,
-        far,
-        slot_size,
-        band_lod,
-        band_strips,
-    })
+    Ok(far)
 }
 
 /// The model of a version-3 file: its arrays with the recipe.

@@ -28,6 +28,7 @@
 //!   steps as the strip has records, even on a corrupt model.
 
 mod build;
+pub mod compress;
 mod digest;
 mod extract;
 pub mod format;

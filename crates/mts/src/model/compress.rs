@@ -1,0 +1,335 @@
+//! Version 5 of the `.mts` file: the version-3 sections, each coded with
+//! Zstandard, the model's records split by column.
+//!
+//! **Decision: a general-purpose coder over the arrays as they are, split
+//! into columns, rather than a coder of our own.** The ready arrays are
+//! about ten stripifications of the mesh (one per band) with their labels
+//! and codes. Measured on the bunny's 6.28 MB `MODL` section
+//! (`docs/experiments/compressed-file.md`): order-0 entropy of the node
+//! vertices' differences is 11.8 bits, but the vertex column codes to
+//! about 8.8 bits a node with Zstandard, because a band's strips repeat
+//! stretches of the band before it, which only a coder that matches
+//! earlier bytes finds; labels code to 1.6 bits a record and codes to 0.7.
+//! Splitting the section into columns, each its own frame, gains 13–20%
+//! over coding it whole (each frame's entropy tables fit one kind of
+//! value). Zstandard decodes at memory speed, which a coder of our own
+//! would have to match. Cost: a C library in the core (`zstd-sys`).
+//!
+//! Layout: the header and section table of version 3 ([`super::format`]),
+//! with the same seven tags; the checksum is of the coded body. Each
+//! section's payload is a varint part count (1, or 5 for `MODL`) and then
+//! per part: the coding (`u8`: 0 stored, 1 a Zstandard frame), a varint
+//! decoded length, a varint coded length and the coded bytes. A section's
+//! decoded parts, concatenated, are its version-3 payload, except that the
+//! `MODL` section's second part (the records' vertices) holds only the
+//! records that start a node (a node's later records hold vertex 0); the
+//! parts of `MODL` are its head (counts, widths, `u32` arrays), vertices,
+//! labels, codes, and tail (far arcs, LoD → triangle table).
+//!
+//! **Decision: a file may decode to at most [`MAX_EXPANSION`] × its own
+//! bytes** in all, checked over every part's header before anything is
+//! decoded or allocated ([`check_expansion`]). Per file, not per part:
+//! a column can legitimately code a thousand to one (the companion section
+//! of a model without seams is one zero byte per step), while the
+//! positions, a fifth of the file, hardly shrink; the writer stores the
+//! densest parts plainly in the (never seen) case that the whole file
+//! would exceed the bound.
+//!
+//! Loading decodes `MODL` on a second thread while the recipe's sections
+//! are decoded, then parses as version 3 does (every count, index and
+//! label checked; the ready walk compared with the recipe's replay).
+
+use super::format::{put_varint, Reader};
+use crate::error::Result;
+
+/// How many times its coded bytes a part may decode to.
+pub(crate) const MAX_EXPANSION: u64 = 1024;
+
+/// The Zstandard level `mts build` writes at: the measured balance of size
+/// and writing time (`docs/experiments/compressed-file.md`: on the bunny,
+/// level 17 writes 3 % more bytes than 19 in half its time, and 12 % fewer
+/// than 15, where Zstandard's slower match search starts).
+pub const DEFAULT_LEVEL: i32 = 17;
+
+const STORED: u8 = 0;
+const ZSTD: u8 = 1;
+
+/// Parts of the `MODL` section.
+const MODL_PARTS: usize = 5;
+
+/// The names of the `MODL` section's parts, for errors.
+const MODL_PART_NAMES: [&str; MODL_PARTS] = ["head", "vertices", "labels", "codes", "tail"];
+
+/// A part as written: its coding and bytes (the data itself where stored).
+struct Coded {
+    coding: u8,
+    frame: Vec<u8>,
+}
+
+/// The version-5 payloads of a model: `recipe` (the six sections before
+/// `MODL`, in their order, a part each) and the `MODL` section's `modl`
+/// parts (vertices of node-starting records only), each coded at `level`
+/// on every core. A part Zstandard does not shrink is stored; then, while
+/// the file would decode to more than [`MAX_EXPANSION`] × its coded bytes,
+/// the part coded most densely is stored instead (never needed on a real
+/// model: positions hardly shrink).
+pub(crate) fn pack(recipe: &[Vec<u8>], modl: &[Vec<u8>; MODL_PARTS], level: i32) -> Vec<Vec<u8>> {
+    let parts: Vec<&Vec<u8>> = recipe.iter().chain(modl.iter()).collect();
+    let mut coded = crate::parallel::map_indexed(
+        parts.len(),
+        || (),
+        |(), i| match zstd::bulk::compress(parts[i], level) {
+            Ok(f) if f.len() < parts[i].len() => Coded {
+                coding: ZSTD,
+                frame: f,
+            },
+            _ => Coded {
+                coding: STORED,
+                frame: Vec::new(),
+            },
+        },
+    );
+    let size = |c: &Coded, p: &Vec<u8>| {
+        if c.coding == ZSTD {
+            c.frame.len()
+        } else {
+            p.len()
+        }
+    };
+    let decoded: u64 = parts.iter().map(|p| p.len() as u64).sum();
+    loop {
+        let total: u64 = coded
+            .iter()
+            .zip(&parts)
+            .map(|(c, p)| size(c, p) as u64)
+            .sum();
+        if decoded <= MAX_EXPANSION * total {
+            break;
+        }
+        let densest = (0..parts.len())
+            .filter(|&i| coded[i].coding == ZSTD)
+            .max_by_key(|&i| parts[i].len() / coded[i].frame.len().max(1));
+        let Some(i) = densest else { break };
+        coded[i].coding = STORED;
+    }
+    let section = |range: std::ops::Range<usize>| {
+        let mut out = Vec::new();
+        put_varint(&mut out, range.len() as u64);
+        for i in range {
+            out.push(coded[i].coding);
+            put_varint(&mut out, parts[i].len() as u64);
+            let bytes: &[u8] = if coded[i].coding == ZSTD {
+                &coded[i].frame
+            } else {
+                parts[i]
+            };
+            put_varint(&mut out, bytes.len() as u64);
+            out.extend_from_slice(bytes);
+        }
+        out
+    };
+    let mut out: Vec<Vec<u8>> = (0..recipe.len()).map(|i| section(i..i + 1)).collect();
+    out.push(section(recipe.len()..parts.len()));
+    out
+}
+
+/// Checks, before anything is decoded, that the parts of a version-5
+/// file's coded `sections` announce at most [`MAX_EXPANSION`] × `file_len`
+/// decoded bytes in all (each part's header checked as it is read), so a
+/// file asks for at most about a thousand times its own size.
+pub(crate) fn check_expansion(sections: &[Reader<'_>], file_len: usize) -> Result<()> {
+    let budget = MAX_EXPANSION * file_len as u64 + 64;
+    let mut total = 0u64;
+    for (i, s) in sections.iter().enumerate() {
+        let mut r = s.clone();
+        let expected = if i + 1 == sections.len() {
+            MODL_PARTS
+        } else {
+            1
+        };
+        part_count(&mut r, expected)?;
+        for name in MODL_PART_NAMES.iter().take(expected) {
+            let name = if expected == 1 { s.section } else { name };
+            let at = r.pos;
+            let part = next_part(&mut r, name)?;
+            total = total.saturating_add(part.decoded);
+            if total > budget {
+                r.pos = at;
+                return Err(r.error(format!(
+                    "{name}: the parts so far decode to {total} bytes, more than \
+                     {MAX_EXPANSION} × the file's {file_len}"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Reads the part count of the section `r` reads, which must be
+/// `expected`.
+fn part_count(r: &mut Reader<'_>, expected: usize) -> Result<()> {
+    let at = r.pos;
+    let count = r.count("part count", expected as u64)?;
+    if count != expected {
+        r.pos = at;
+        return Err(r.error(format!("{count} parts, expected {expected}")));
+    }
+    Ok(())
+}
+
+/// A part whose header has been read: where it is, and what it is.
+pub(crate) struct Part<'a> {
+    at: usize,
+    name: &'static str,
+    coding: u8,
+    decoded: u64,
+    bytes: &'a [u8],
+}
+
+/// Reads the next part's header from `r`, checked against the bytes left,
+/// and steps over its bytes ([`check_expansion`] bounds what they decode
+/// to). `name` names it in
+/// errors.
+fn next_part<'a>(r: &mut Reader<'a>, name: &'static str) -> Result<Part<'a>> {
+    let at = r.pos;
+    let coding = r.u8()?;
+    let decoded = r.varint()?;
+    let coded = r.count(&format!("{name}: coded length"), r.remaining() as u64)?;
+    let all: &'a [u8] = r.bytes;
+    let start = r.pos;
+    r.take(coded)?;
+    let bytes = &all[start..start + coded];
+    let problem = match coding {
+        STORED if decoded != coded as u64 => Some(format!("stored, {coded} bytes for {decoded}")),
+        STORED | ZSTD => None,
+        c => Some(format!("coding {c}, not 0 (stored) or 1 (Zstandard)")),
+    };
+    if let Some(p) = problem {
+        r.pos = at;
+        return Err(r.error(format!("{name}: {p}")));
+    }
+    Ok(Part {
+        at,
+        name,
+        coding,
+        decoded,
+        bytes,
+    })
+}
+
+impl Part<'_> {
+    /// Decodes the part straight into `out`, little-endian `T`s: its
+    /// announced length must be `out`'s. `r` (the section's reader) places
+    /// errors.
+    pub(crate) fn decode_into<T: bytemuck::Pod>(
+        &self,
+        r: &Reader<'_>,
+        out: &mut [T],
+        from_le: fn(T) -> T,
+    ) -> Result<()> {
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(out);
+        let expected = bytes.len();
+        let got = if self.decoded != expected as u64 {
+            Err(format!("{} bytes, {expected} expected", self.decoded))
+        } else if self.coding == STORED {
+            bytes.copy_from_slice(self.bytes);
+            Ok(())
+        } else {
+            match zstd::bulk::decompress_to_buffer(self.bytes, bytes) {
+                Ok(n) if n == expected => Ok(()),
+                Ok(n) => Err(format!(
+                    "the Zstandard frame decodes to {n} bytes, {expected} announced"
+                )),
+                Err(e) => Err(format!(
+                    "the Zstandard frame of {} bytes does not decode to the {expected} \
+                     announced: {e}",
+                    self.bytes.len()
+                )),
+            }
+        };
+        match got {
+            Ok(()) => {
+                if cfg!(target_endian = "big") {
+                    out.iter_mut().for_each(|x| *x = from_le(*x));
+                }
+                Ok(())
+            }
+            Err(problem) => {
+                let mut at = r.clone();
+                at.pos = self.at;
+                Err(at.error(format!("{}: {problem}", self.name)))
+            }
+        }
+    }
+
+    /// The bytes the part announces it decodes to (bounded, with the
+    /// other parts', by [`check_expansion`]).
+    pub(crate) fn decoded_len(&self) -> u64 {
+        self.decoded
+    }
+
+    /// The decoded bytes, into a buffer of the announced length at most
+    /// (the decoder stops where it would need more). `r` (the section's
+    /// reader) places errors.
+    pub(crate) fn decode(&self, r: &Reader<'_>) -> Result<Vec<u8>> {
+        if self.coding == STORED {
+            return Ok(self.bytes.to_vec());
+        }
+        let (decoded, coded) = (self.decoded, self.bytes.len());
+        let problem = match zstd::bulk::decompress(self.bytes, decoded as usize) {
+            Ok(out) if out.len() as u64 == decoded => return Ok(out),
+            Ok(out) => format!(
+                "the Zstandard frame decodes to {} bytes, {decoded} announced",
+                out.len()
+            ),
+            Err(e) => format!(
+                "the Zstandard frame of {coded} bytes does not decode to the {decoded} \
+                 announced: {e}"
+            ),
+        };
+        let mut at = r.clone();
+        at.pos = self.at;
+        Err(at.error(format!("{}: {problem}", self.name)))
+    }
+}
+
+/// The one part of a recipe section of a version-5 file, its header read.
+pub(crate) fn only_part<'a>(section: &Reader<'a>) -> Result<(Reader<'a>, Part<'a>)> {
+    let mut r = section.clone();
+    part_count(&mut r, 1)?;
+    let name = r.section;
+    let part = next_part(&mut r, name)?;
+    r.finish()?;
+    Ok((r, part))
+}
+
+/// The version-3 payloads of a version-5 file's recipe `sections` (one
+/// part each).
+pub(crate) fn unpack_recipe(sections: Vec<Reader<'_>>) -> Result<Vec<Vec<u8>>> {
+    sections
+        .into_iter()
+        .map(|s| {
+            let (r, part) = only_part(&s)?;
+            part.decode(&r)
+        })
+        .collect()
+}
+
+/// The tail of a version-5 `MODL` section (far arcs and the LoD → triangle
+/// table), decoded alone: what the recipe's side of the loader reads.
+pub(crate) fn modl_tail(mut r: Reader<'_>) -> Result<Vec<u8>> {
+    let parts = modl_parts(&mut r)?;
+    parts[MODL_PARTS - 1].decode(&r)
+}
+
+/// The headers of a version-5 `MODL` section's parts, read from `r` to its
+/// end.
+pub(crate) fn modl_parts<'a>(r: &mut Reader<'a>) -> Result<Vec<Part<'a>>> {
+    part_count(r, MODL_PARTS)?;
+    let parts = MODL_PART_NAMES
+        .iter()
+        .map(|name| next_part(r, name))
+        .collect::<Result<Vec<_>>>()?;
+    r.finish()?;
+    Ok(parts)
+}
