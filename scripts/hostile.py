@@ -10,9 +10,10 @@ Commands
 CI slice (fixed seed 19, timeout 10 s): the issue-19 families' 600 inputs
 (about 1,700 runs; no heavy extreme mesh, no argument that is slow even
 when handled right, one render run), the same inputs as before issue 31,
-then a fixed slice of each issue-31 family (161 inputs, about 300 runs)
-and of the issue-33 one, hier (24 inputs, 72 runs: QUICK_SLICE); about
-50 s on 2 cores with a sound binary::
+then a fixed slice of each issue-31 family (161 inputs, about 300 runs),
+of the issue-33 one, hier (24 inputs, 72 runs) and of the issue-34 one,
+coded (24 inputs, 72 runs: QUICK_SLICE); about a minute on 2 cores with a
+sound binary::
 
     python3 scripts/hostile.py --mts target/release/mts --quick
 
@@ -25,11 +26,11 @@ each hang adds up to --timeout)::
 The issue-31 families alone (the figure in its closing note)::
 
     python3 scripts/hostile.py --mts target/release/mts \
-        --families gltf,amplify,fifo,output,view,props,reseal,hier --count 600
+        --families gltf,amplify,fifo,output,view,props,reseal,hier,coded --count 600
 
 Other options: --seed N, --count N (inputs), --timeout S (20), --mem-gb G (4),
 --families obj,ply,mts,stream,args,extreme,gltf,amplify,fifo,output,view,
-props,reseal,hier, --jobs N (2), --list-limit N. The same seed, count and
+props,reseal,hier,coded, --jobs N (2), --list-limit N. The same seed, count and
 --families give the same inputs whatever --jobs says (each input is drawn
 from its own generator, seeded by seed and index). With --quick, --families
 picks among the slices (the issue-19 ones share 600 inputs as before).
@@ -190,6 +191,17 @@ hier     version-4 files (`build --hierarchy`: a terrain, a torus with
          a group's model sections (possibly valid: `verify` sweeps
          cameras for cracks). `extract` must refuse every one (a
          hierarchy is not a model) naming the file.
+coded    version-5 files (`mts build`'s default: a torus, an
+         optimal-placement icosphere at level 3, a torus with properties;
+         V5File) truncated, flipped, resealed flipped, and with one field
+         changed and the file resealed: a section's part count, a part's
+         decoded length (+-1, doubled, huge), its coding byte, a coded part
+         called stored, a byte flipped in a Zstandard frame or the frame
+         cut, MODL's parts swapped, a hand-made frame of RLE blocks (a
+         "bomb": kilobytes decoding to up to 256 MiB, announced honestly
+         or not), the section count, trailing bytes. All refused by
+         `verify`, `info` and `extract` but a flip in a frame, which
+         `verify` decides.
 
 Checksums (read from src/model/format.rs and src/baselines/cluster/stream.rs):
 .mts: header "MTSMODEL" | version u32 | section count u32 | file length u64
@@ -269,16 +281,17 @@ from concurrent.futures import ThreadPoolExecutor
 
 # The issue-19 families, then the issue-31 ones (and issue 33's hier).
 OLD_FAMILIES = ["obj", "ply", "mts", "stream", "args", "extreme"]
-NEW_FAMILIES = ["gltf", "amplify", "fifo", "output", "view", "props", "reseal", "hier"]
+NEW_FAMILIES = ["gltf", "amplify", "fifo", "output", "view", "props", "reseal", "hier", "coded"]
 FAMILIES = OLD_FAMILIES + NEW_FAMILIES
 # Share of the inputs per family.
 WEIGHTS = {"obj": 26, "ply": 25, "mts": 19, "stream": 15, "extreme": 9, "args": 6,
-           "gltf": 14, "amplify": 1, "fifo": 2, "output": 6, "view": 2, "props": 3, "reseal": 9, "hier": 6}
+           "gltf": 14, "amplify": 1, "fifo": 2, "output": 6, "view": 2, "props": 3, "reseal": 9, "hier": 6,
+           "coded": 6}
 DEFAULT_COUNT = 3700
 QUICK_COUNT = 600  # the issue-19 families' share of --quick
 # --quick: a fixed slice of each issue-31 family, after those 600 inputs.
 QUICK_SLICE = {"gltf": 36, "amplify": 4, "fifo": 10, "output": 64, "view": 10, "props": 13, "reseal": 24,
-               "hier": 24}
+               "hier": 24, "coded": 24}
 QUICK_SEED = 19
 QUICK_TIMEOUT = 10
 
@@ -3675,6 +3688,185 @@ def gen_hier(rng, seeds, index, quick=False):
     return case
 
 
+# --- version-5 files: the coded model ------------------------------------------
+
+
+class V5File:
+    """A version-5 .mts file (crates/mts/src/model/compress.rs): the seven
+    sections of version 3, each payload a part count and parts (coding u8,
+    decoded length, coded length varints, bytes; MODL has five)."""
+
+    TAGS = [b"META", b"POSI", b"STRP", b"STEP", b"PROP", b"CMPN", b"MODL"]
+
+    def __init__(self, data):
+        self.version, count = struct.unpack_from("<II", data, 8)
+        if self.version != 5 or count != 7:
+            raise ValueError("not a version-5 file")
+        pos = MTS_HEADER
+        self.sections = []
+        for _ in range(count):
+            tag = bytes(data[pos : pos + 4])
+            n = struct.unpack_from("<Q", data, pos + 4)[0]
+            payload = bytes(data[pos + 12 : pos + 12 + n])
+            p = 0
+            k, p = get_varint(payload, p)
+            parts = []
+            for _ in range(k):
+                coding = payload[p]
+                decoded, p = get_varint(payload, p + 1)
+                coded, p = get_varint(payload, p)
+                parts.append([coding, decoded, payload[p : p + coded]])
+                p += coded
+            if p != len(payload):
+                raise ValueError("section %s: parts end at %d of %d" % (tag, p, len(payload)))
+            self.sections.append([tag, parts])
+            pos += 12 + n
+        if pos != len(data):
+            raise ValueError("sections do not end at the end of the file")
+        if [t for t, _ in self.sections] != self.TAGS:
+            raise ValueError("sections %s" % [t for t, _ in self.sections])
+        self.count_override = {}
+        self.section_count = count
+        self.trailing = b""
+
+    def to_bytes(self):
+        body = bytearray()
+        for i, (tag, parts) in enumerate(self.sections):
+            payload = bytearray()
+            put_varint(payload, self.count_override.get(i, len(parts)))
+            for coding, decoded, data in parts:
+                payload.append(coding & 0xFF)
+                put_varint(payload, decoded)
+                put_varint(payload, len(data))
+                payload += data
+            body += tag + struct.pack("<Q", len(payload)) + payload
+        head = b"MTSMODEL" + struct.pack("<II", self.version, self.section_count) + struct.pack("<QQ", 0, 0)
+        return seal_mts(head + bytes(body) + self.trailing)
+
+
+def zstd_rle_frame(blocks, byte=0):
+    """A Zstandard frame of `blocks` RLE blocks of 128 KiB each (RFC 8878:
+    magic, a descriptor without content size, a 128 KiB window, 3-byte block
+    headers of type 1 with the repeat count, one byte each): a few bytes
+    that decode to blocks x 128 KiB."""
+    out = bytearray(struct.pack("<I", 0xFD2FB528))
+    out += bytes([0x00, 7 << 3])
+    for i in range(blocks):
+        last = 1 if i + 1 == blocks else 0
+        header = last | (1 << 1) | ((128 << 10) << 3)
+        out += struct.pack("<I", header)[:3] + bytes([byte])
+    return bytes(out)
+
+
+CODED_SEEDS = ("torus_v5.mts", "ico_optimal_v5.mts", "torus_props_v5.mts")
+CODED_KINDS = ["truncate", "flip", "reseal_flip", "part_count", "decoded_len", "decoded_huge", "coding",
+               "stored_lie", "frame_flip", "frame_cut", "parts_swapped", "bomb", "bomb_honest", "section_count",
+               "trailing", "clean"]
+# Edits that may leave a valid model (a frame whose flipped byte decodes to
+# the same, or to arrays that pass the checks and draw otherwise: verify
+# decides).
+CODED_UNKNOWN = ("reseal_flip", "frame_flip")
+
+
+def coded_edit(rng, f, kind):
+    """Applies `kind` to a parsed V5File in place; returns a label, or None
+    when it has nothing to change."""
+    i = rng.randrange(len(f.sections))
+    tag, parts = f.sections[i]
+    j = rng.randrange(len(parts))
+    part = parts[j]
+    name = "%s.%d" % (tag.decode(), j)
+    if kind == "part_count":
+        f.count_override[i] = rng.choice([0, len(parts) + 1, len(parts) - 1 if len(parts) > 1 else 2, 2 ** 40])
+        return "%s:%d" % (tag.decode(), f.count_override[i])
+    if kind == "decoded_len":
+        part[1] = max(0, part[1] + rng.choice([-1, 1, 2, -2, part[1]]))
+        return name
+    if kind == "decoded_huge":
+        part[1] = rng.choice([2 ** 32, 2 ** 40, 2 ** 63, 2 ** 64 - 1, 10 ** 12])
+        return name
+    if kind == "coding":
+        part[0] = rng.choice([2, 3, 127, 255])
+        return name
+    if kind == "stored_lie":
+        if part[0] != 1:
+            return None
+        part[0] = 0
+        return name
+    if kind in ("frame_flip", "frame_cut"):
+        coded = [(a, b) for a, (_, ps) in enumerate(f.sections) for b, p in enumerate(ps) if p[0] == 1 and len(p[2]) > 8]
+        if not coded:
+            return None
+        a, b = rng.choice(coded)
+        p = f.sections[a][1][b]
+        data = bytearray(p[2])
+        if kind == "frame_flip":
+            k = rng.randrange(4, len(data))
+            data[k] ^= rng.randrange(1, 256)
+        else:
+            del data[rng.randrange(1, len(data)) :]
+        p[2] = bytes(data)
+        return "%s.%d" % (f.sections[a][0].decode(), b)
+    if kind == "parts_swapped":
+        modl = f.sections[6][1]
+        a, b = rng.sample(range(len(modl)), 2)
+        modl[a], modl[b] = modl[b], modl[a]
+        return "MODL.%d<->%d" % (a, b)
+    if kind in ("bomb", "bomb_honest"):
+        # A few kilobytes that decode to up to 256 MiB: announced honestly,
+        # or as the part's own length (the decoder must stop there).
+        blocks = rng.choice([64, 512, 2048])
+        frame = zstd_rle_frame(blocks)
+        part[0] = 1
+        part[1] = blocks * (128 << 10) if kind == "bomb_honest" else part[1]
+        part[2] = frame
+        return "%s:%d" % (name, blocks)
+    if kind == "section_count":
+        f.section_count = rng.choice([0, 6, 8, 2 ** 32 - 1])
+        return str(f.section_count)
+    if kind == "trailing":
+        f.trailing = bytes(rng.randrange(256) for _ in range(rng.randint(1, 16)))
+        return "trailing"
+    return None
+
+
+def gen_coded(rng, seeds, index, quick=False):
+    name = CODED_SEEDS[index % len(CODED_SEEDS)]
+    full = seeds.v5[name]
+    kind = CODED_KINDS[index % len(CODED_KINDS)] if quick else rng.choice(CODED_KINDS)
+    label, data = kind, None
+    if kind == "truncate":
+        data = truncate(rng, full)
+    elif kind == "flip":
+        data, _ = flip(rng, full)
+    elif kind == "reseal_flip":
+        data = seal_mts(flip(rng, full, start=MTS_HEADER)[0])
+    elif kind != "clean":
+        for _ in range(20):
+            f = V5File(full)
+            label = coded_edit(rng, f, kind)
+            if label:
+                data = f.to_bytes()
+                break
+    if data is None:
+        kind = label = "clean"
+        data = full
+    expect = ACCEPT if kind == "clean" else UNKNOWN if kind in CODED_UNKNOWN else GARBAGE
+    case = Case("coded", "%s/%s:%s" % (kind, name[:-4], label), ".mts", data)
+    case.run(["verify", "{in}", "--lods", "4"], expect)
+    refused = ("clean error", "unnamed error", "valid refused", "wrong message")
+
+    def by_verify(prev):
+        if expect != UNKNOWN:
+            return expect
+        return TRUSTED if prev[0]["cls"] in refused else UNKNOWN
+
+    case.run(["info", "{in}", "--json"] if rng.random() < 0.3 else ["info", "{in}"], by_verify)
+    case.run(rng.choice([["extract", "{in}", "--lod", "0", "--repeat", "1"],
+                         ["extract", "{in}", "--ratio", "0.5", "--repeat", "1", "--json"]]), by_verify)
+    return case
+
+
 # --------------------------------------------------------------------------
 # Running and classifying
 
@@ -3704,11 +3896,15 @@ def make_seeds(mts_bin, root, timeout):
         "ico_optimal.mts": ["build", "--generated", "icosphere:80", "--optimal", "--recipe-only", "-o"],
         "grid_single.mts": ["build", "--generated", "grid:50", "--single-band", "--recipe-only", "-o"],
         "cube.mts": ["build", cube, "--recipe-only", "-o"],
-        "torus_v3.mts": ["build", "--generated", "torus:200", "-o"],
-        "ico_optimal_v3.mts": ["build", "--generated", "icosphere:80", "--optimal", "-o"],
+        "torus_v3.mts": ["build", "--generated", "torus:200", "--uncompressed", "-o"],
+        "ico_optimal_v3.mts": ["build", "--generated", "icosphere:80", "--optimal", "--uncompressed", "-o"],
         # The reseal family's (issue 31): a single band, and properties.
-        "grid_single_v3.mts": ["build", "--generated", "grid:60", "--single-band", "-o"],
-        "torus_props_v3.mts": ["build", "--generated", "torus:300", "--properties", "-o"],
+        "grid_single_v3.mts": ["build", "--generated", "grid:60", "--single-band", "--uncompressed", "-o"],
+        "torus_props_v3.mts": ["build", "--generated", "torus:300", "--properties", "--uncompressed", "-o"],
+        # The coded family's (issue 34): version 5, what `mts build` writes.
+        "torus_v5.mts": ["build", "--generated", "torus:300", "-o"],
+        "ico_optimal_v5.mts": ["build", "--generated", "icosphere:80", "--optimal", "--level", "3", "-o"],
+        "torus_props_v5.mts": ["build", "--generated", "torus:300", "--properties", "-o"],
         # The hier family's: version-4 hierarchies.
         "terrain_h.mts": ["build", "--generated", "terrain:2k", "--hierarchy", "-o"],
         "torus_props_h.mts": ["build", "--generated", "torus:1k", "--properties", "--hierarchy", "-o"],
@@ -3717,7 +3913,7 @@ def make_seeds(mts_bin, root, timeout):
         "grid.stream": ["encode", "--generated", "grid:32", "-o"],
         "cube.stream": ["encode", cube, "-o"],
     }
-    s.mts, s.stream, s.v3, s.v4 = {}, {}, {}, {}
+    s.mts, s.stream, s.v3, s.v4, s.v5 = {}, {}, {}, {}, {}
     for name, argv in jobs.items():
         out = os.path.join(s.dir, name)
         p = subprocess.run([mts_bin] + argv + [out], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
@@ -3730,6 +3926,8 @@ def make_seeds(mts_bin, root, timeout):
             s.v3[name] = data
         elif name in HIER_SEEDS:
             s.v4[name] = data
+        elif name in CODED_SEEDS:
+            s.v5[name] = data
         else:
             (s.mts if name.endswith(".mts") else s.stream)[name] = data
     for name, data in list(s.mts.items()) + list(s.v3.items()):
@@ -3744,6 +3942,13 @@ def make_seeds(mts_bin, root, timeout):
                 raise RuntimeError("seed %s: taking the version-3 file apart and back changes it" % name)
         if seal_mts(data) != data:
             raise RuntimeError("seed %s: resealing changes it; the .mts checksum is not the one of its version" % name)
+    for name, data in s.v5.items():
+        try:
+            f = V5File(data)
+        except (ValueError, struct.error, IndexError) as e:
+            raise RuntimeError("seed %s: the version-5 layout is not the one this harness knows: %s" % (name, e))
+        if f.to_bytes() != data:
+            raise RuntimeError("seed %s: taking the version-5 file apart and back changes it" % name)
     for name, data in s.v4.items():
         try:
             f = V4File(data)
@@ -3778,7 +3983,7 @@ def build_case(seed, index, family, seeds, family_index, render_budget, quick=Fa
     if family == "extreme":
         return gen_extreme(rng, seeds, family_index, quick)
     gen = {"gltf": gen_gltf, "amplify": gen_amplify, "fifo": gen_fifo, "output": gen_output, "view": gen_view,
-           "props": gen_props, "reseal": gen_reseal, "hier": gen_hier}[family]
+           "props": gen_props, "reseal": gen_reseal, "hier": gen_hier, "coded": gen_coded}[family]
     return gen(rng, seeds, family_index, quick)
 
 

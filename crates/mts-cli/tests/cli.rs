@@ -74,6 +74,65 @@ fn build_extract_verify_round_trip() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Issue 34: `build` writes the coded file (version 5) by default, the
+/// uncoded one (version 3) with `--uncompressed`, at another level with
+/// `--level`; the three load to the same model (the same indices at every
+/// level `info` prints) and `info` names the version.
+#[test]
+fn build_writes_the_coded_file_by_default() {
+    let dir = std::env::temp_dir().join(format!("mts-cli-coded-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let mut sizes = Vec::new();
+    let mut levels = Vec::new();
+    for (name, extra) in [
+        ("coded.mts", vec![]),
+        ("plain.mts", vec!["--uncompressed"]),
+        ("fast.mts", vec!["--level", "1"]),
+    ] {
+        let out = path(name);
+        let mut args = vec!["build", "--generated", "torus:5k", "-o", &out, "--json"];
+        args.extend(extra.iter().copied());
+        let (ok, text, err) = mts(&args);
+        assert!(ok, "{name}: {err}");
+        let b = json(&text);
+        assert_eq!(
+            b["bytes"].as_u64().unwrap(),
+            std::fs::metadata(&out).unwrap().len()
+        );
+        let (ok, info, err) = mts(&["info", &out, "--json"]);
+        assert!(ok, "{name}: {err}");
+        let info = json(&info);
+        assert_eq!(info["file_version"], b["file_version"], "{name}");
+        sizes.push((
+            b["file_version"].as_u64().unwrap(),
+            b["bytes"].as_u64().unwrap(),
+        ));
+        levels.push(info["levels"].clone());
+    }
+    assert_eq!(sizes[0].0, 5);
+    assert_eq!(sizes[1].0, 3);
+    assert_eq!(sizes[2].0, 5);
+    assert!(sizes[0].1 * 2 < sizes[1].1, "{sizes:?}");
+    assert!(sizes[0].1 <= sizes[2].1, "level 17 against 1: {sizes:?}");
+    assert_eq!(levels[0], levels[1]);
+    assert_eq!(levels[0], levels[2]);
+    // A level outside Zstandard's and a level with the uncoded file are
+    // refused by the argument parser.
+    let out = path("x.mts");
+    for bad in [
+        vec!["--level", "0"],
+        vec!["--level", "23"],
+        vec!["--level", "9", "--uncompressed"],
+    ] {
+        let mut args = vec!["build", "--generated", "torus:200", "-o", &out];
+        args.extend(bad.iter().copied());
+        let (ok, _, err) = mts(&args);
+        assert!(!ok && err.contains("--level"), "{bad:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn verify_takes_a_mesh_and_spread_lods() {
     let (ok, out, err) = mts(&[

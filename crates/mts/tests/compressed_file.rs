@@ -302,6 +302,54 @@ fn amplifying_files_are_refused_before_allocating() {
     );
 }
 
+/// A Zstandard frame of `blocks` RLE blocks of 128 KiB (RFC 8878: magic, a
+/// descriptor without content size, a 128 KiB window, per block a 3-byte
+/// header of type 1 with the repeat count and the byte): a few bytes that
+/// decode to `blocks` × 128 KiB.
+fn rle_frame(blocks: usize) -> Vec<u8> {
+    let mut out = 0xFD2F_B528u32.to_le_bytes().to_vec();
+    out.extend_from_slice(&[0x00, 7 << 3]);
+    for i in 0..blocks {
+        let header = u32::from(i + 1 == blocks) | 1 << 1 | (128 << 10) << 3;
+        out.extend_from_slice(&header.to_le_bytes()[..3]);
+        out.push(0);
+    }
+    out
+}
+
+/// A "bomb": a frame of a few kilobytes that decodes to 256 MiB, in place
+/// of the labels. Announced honestly, the file asks for more than 1,024 ×
+/// its bytes and is refused before decoding; announced as the labels'
+/// length, the decoder stops at that length and the part is refused.
+#[test]
+fn a_frame_that_decodes_to_far_more_is_refused() {
+    let frame = rle_frame(2048);
+    assert_eq!(
+        zstd::bulk::decompress(&rle_frame(3), 3 << 17)
+            .unwrap()
+            .len(),
+        3 << 17,
+        "the hand-made frame is one Zstandard decodes"
+    );
+    let good = small().to_compressed_bytes(9);
+    let mut s = sections(&good);
+    let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
+    let original = parts(&s[modl].2);
+    for announced in [2048u64 << 17, original[2].1] {
+        let mut ps = original.clone();
+        ps[2] = (1, announced, frame.clone());
+        s[modl].2 = payload_of(&ps);
+        let bytes = file_of(&s);
+        assert!(bytes.len() < 100_000);
+        let e = load(&bytes).unwrap_err();
+        assert!(place(&e).0.starts_with("MODL"), "{e}");
+        assert!(
+            e.to_string().contains("more than 1024 ×") || e.to_string().contains("labels"),
+            "{e}"
+        );
+    }
+}
+
 /// A ready file that lies (a decoded vertex changed, coded again, the file
 /// resealed) meets the same checks as version 3's: the first band's nodes
 /// born at LoD 0 (most of the first records) are walked on every load, so

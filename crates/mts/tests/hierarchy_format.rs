@@ -272,16 +272,20 @@ fn each_loader_names_a_file_of_the_other_kind() {
         "{text}"
     );
     let (model, _, _) = mts::model::build_from_mesh(&mesh, &Default::default(), &mut |_, _| {});
-    for model_bytes in [model.to_bytes(), model.to_recipe_bytes()] {
+    for model_bytes in [
+        model.to_bytes(),
+        model.to_recipe_bytes(),
+        model.to_compressed_bytes(3),
+    ] {
         assert_eq!(holds(&model_bytes), Some(Holds::Model));
         let text = assert_parse_error(load(&model_bytes), "a model");
         assert!(text.contains("per-object model"), "{text}");
     }
     let mut other = bytes.clone();
-    other[8] = 5;
+    other[8] = 6;
     assert_eq!(holds(&other), None);
-    let text = assert_parse_error(load(&other), "version 5");
-    assert!(text.contains("version 5"), "{text}");
+    let text = assert_parse_error(load(&other), "version 6");
+    assert!(text.contains("version 6"), "{text}");
     assert_eq!(holds(b"MTSMODEL"), None);
 }
 

@@ -27,6 +27,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         return hierarchy_info(args, &bytes, t0);
     }
     let model = MtsModel::from_bytes(&bytes, &args.model)?;
+    let version = mts::model::format::file_version(&bytes).unwrap_or(0);
     drop(bytes);
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let file_bytes = std::fs::metadata(&args.model)
@@ -62,6 +63,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         let mut v = json!({
             "file": args.model.display().to_string(),
             "file_bytes": file_bytes,
+            "file_version": version,
                 "raw_bytes": model.raw_bytes(),
                 "load_ms": load_ms,
                 "vertices": model.positions().len(),
@@ -85,8 +87,14 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         }
         outln!("{}", serde_json::to_string_pretty(&v)?)?;
     } else {
+        // Versions 1 and 2 hold the recipe only: loading builds the model.
+        let how = if version < 3 {
+            "loaded and built"
+        } else {
+            "loaded"
+        };
         outln!(
-            "{}: {} bytes ({:.2} x raw), loaded and built in {load_ms:.1} ms",
+            "{}: {} bytes ({:.2} x raw), version {version}, {how} in {load_ms:.1} ms",
             args.model.display(),
             file_bytes,
             file_bytes as f64 / model.raw_bytes() as f64
