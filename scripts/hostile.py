@@ -195,8 +195,9 @@ coded    version-5 files (`mts build`'s default: a torus, an
          optimal-placement icosphere at level 3, a torus with properties;
          V5File) truncated, flipped, resealed flipped, and with one field
          changed and the file resealed: a section's part count, a part's
-         decoded length (+-1, doubled, huge), its coding byte, a coded part
-         called stored, a byte flipped in a Zstandard frame or the frame
+         decoded length (+-1, doubled, huge), its coding byte, a
+         transposed part's row width (or a plain frame called transposed),
+         a coded part called stored, a byte flipped in a Zstandard frame or the frame
          cut, MODL's parts swapped, a hand-made frame of RLE blocks (a
          "bomb": kilobytes decoding to up to 256 MiB, announced honestly
          or not), the section count, trailing bytes. All refused by
@@ -3693,8 +3694,10 @@ def gen_hier(rng, seeds, index, quick=False):
 
 class V5File:
     """A version-5 .mts file (crates/mts/src/model/compress.rs): the seven
-    sections of version 3, each payload a part count and parts (coding u8,
-    decoded length, coded length varints, bytes; MODL has five)."""
+    sections of version 3, each payload a part count and parts (coding u8:
+    0 stored, 1 Zstandard, 2 transposed then a row width u8, 3 the steps by
+    column; decoded length, coded length varints, bytes; MODL has six). A
+    part is [coding, decoded, bytes, width]."""
 
     TAGS = [b"META", b"POSI", b"STRP", b"STEP", b"PROP", b"CMPN", b"MODL"]
 
@@ -3713,9 +3716,14 @@ class V5File:
             parts = []
             for _ in range(k):
                 coding = payload[p]
-                decoded, p = get_varint(payload, p + 1)
+                p += 1
+                width = None
+                if coding == 2:
+                    width = payload[p]
+                    p += 1
+                decoded, p = get_varint(payload, p)
                 coded, p = get_varint(payload, p)
-                parts.append([coding, decoded, payload[p : p + coded]])
+                parts.append([coding, decoded, payload[p : p + coded], width])
                 p += coded
             if p != len(payload):
                 raise ValueError("section %s: parts end at %d of %d" % (tag, p, len(payload)))
@@ -3734,8 +3742,10 @@ class V5File:
         for i, (tag, parts) in enumerate(self.sections):
             payload = bytearray()
             put_varint(payload, self.count_override.get(i, len(parts)))
-            for coding, decoded, data in parts:
+            for coding, decoded, data, width in parts:
                 payload.append(coding & 0xFF)
+                if width is not None:
+                    payload.append(width & 0xFF)
                 put_varint(payload, decoded)
                 put_varint(payload, len(data))
                 payload += data
@@ -3761,11 +3771,12 @@ def zstd_rle_frame(blocks, byte=0):
 CODED_SEEDS = ("torus_v5.mts", "ico_optimal_v5.mts", "torus_props_v5.mts")
 CODED_KINDS = ["truncate", "flip", "reseal_flip", "part_count", "decoded_len", "decoded_huge", "coding",
                "stored_lie", "frame_flip", "frame_cut", "parts_swapped", "bomb", "bomb_honest", "section_count",
-               "trailing", "clean"]
+               "trailing", "width", "width_claimed", "clean"]
 # Edits that may leave a valid model (a frame whose flipped byte decodes to
-# the same, or to arrays that pass the checks and draw otherwise: verify
-# decides).
-CODED_UNKNOWN = ("reseal_flip", "frame_flip")
+# the same, or to arrays that pass the checks and draw otherwise; a plain
+# frame called transposed, which changes nothing in a part of equal rows,
+# such as the zero companions: verify decides).
+CODED_UNKNOWN = ("reseal_flip", "frame_flip", "width_claimed")
 
 
 def coded_edit(rng, f, kind):
@@ -3786,15 +3797,31 @@ def coded_edit(rng, f, kind):
         part[1] = rng.choice([2 ** 32, 2 ** 40, 2 ** 63, 2 ** 64 - 1, 10 ** 12])
         return name
     if kind == "coding":
-        part[0] = rng.choice([2, 3, 127, 255])
+        part[0] = rng.choice([4, 127, 255])
+        part[3] = None
         return name
-    if kind == "stored_lie":
+    if kind == "width":
+        # A transposed part's row width: 0, past 16, or one its length is
+        # not a multiple of.
+        if part[0] != 2:
+            return None
+        bad = [w for w in (0, 17, 255, part[3] + 1, 5, 7) if w == 0 or w > 16 or part[1] % w != 0]
+        part[3] = rng.choice(bad)
+        return "%s:%s" % (name, part[3])
+    if kind == "width_claimed":
+        # A plain frame called transposed.
         if part[0] != 1:
             return None
-        part[0] = 0
+        part[0], part[3] = 2, rng.choice([w for w in (2, 4, 12, 16) if part[1] % w == 0] or [1])
+        return "%s:%s" % (name, part[3])
+    if kind == "stored_lie":
+        if part[0] not in (1, 2, 3):
+            return None
+        part[0], part[3] = 0, None
         return name
     if kind in ("frame_flip", "frame_cut"):
-        coded = [(a, b) for a, (_, ps) in enumerate(f.sections) for b, p in enumerate(ps) if p[0] == 1 and len(p[2]) > 8]
+        coded = [(a, b) for a, (_, ps) in enumerate(f.sections) for b, p in enumerate(ps)
+                 if p[0] in (1, 2, 3) and len(p[2]) > 8]
         if not coded:
             return None
         a, b = rng.choice(coded)
@@ -3817,7 +3844,7 @@ def coded_edit(rng, f, kind):
         # or as the part's own length (the decoder must stop there).
         blocks = rng.choice([64, 512, 2048])
         frame = zstd_rle_frame(blocks)
-        part[0] = 1
+        part[0], part[3] = 1, None
         part[1] = blocks * (128 << 10) if kind == "bomb_honest" else part[1]
         part[2] = frame
         return "%s:%d" % (name, blocks)

@@ -75,14 +75,22 @@ fn put_varint(out: &mut Vec<u8>, mut v: u64) {
     out.push(v as u8);
 }
 
-/// A section payload's parts: (coding, decoded length, coded bytes).
-fn parts(payload: &[u8]) -> Vec<(u8, u64, Vec<u8>)> {
+/// A part: (coding, decoded length, coded bytes), the coding's width in
+/// its high byte for a transposed part (coding 2).
+type Part = (u16, u64, Vec<u8>);
+
+/// A section payload's parts.
+fn parts(payload: &[u8]) -> Vec<Part> {
     let mut at = 0;
     let n = varint(payload, &mut at);
     (0..n)
         .map(|_| {
-            let coding = payload[at];
+            let mut coding = u16::from(payload[at]);
             at += 1;
+            if coding == 2 {
+                coding |= u16::from(payload[at]) << 8;
+                at += 1;
+            }
             let decoded = varint(payload, &mut at);
             let coded = varint(payload, &mut at) as usize;
             at += coded;
@@ -91,11 +99,14 @@ fn parts(payload: &[u8]) -> Vec<(u8, u64, Vec<u8>)> {
         .collect()
 }
 
-fn payload_of(parts: &[(u8, u64, Vec<u8>)]) -> Vec<u8> {
+fn payload_of(parts: &[Part]) -> Vec<u8> {
     let mut out = Vec::new();
     put_varint(&mut out, parts.len() as u64);
     for (coding, decoded, bytes) in parts {
-        out.push(*coding);
+        out.push(*coding as u8);
+        if *coding & 0xff == 2 {
+            out.push((*coding >> 8) as u8);
+        }
         put_varint(&mut out, *decoded);
         put_varint(&mut out, bytes.len() as u64);
         out.extend_from_slice(bytes);
@@ -103,11 +114,46 @@ fn payload_of(parts: &[(u8, u64, Vec<u8>)]) -> Vec<u8> {
     out
 }
 
-/// The decoded bytes of a part.
-fn decoded(part: &(u8, u64, Vec<u8>)) -> Vec<u8> {
-    match part.0 {
+fn untranspose(t: &[u8], width: usize) -> Vec<u8> {
+    let rows = t.len() / width;
+    let mut out = vec![0; t.len()];
+    for r in 0..rows {
+        for c in 0..width {
+            out[r * width + c] = t[c * rows + r];
+        }
+    }
+    out
+}
+
+/// The decoded bytes of a part (transposed back for coding 2; for coding
+/// 3, the steps' rows of removed vertex, zigzagged kept-vertex and
+/// error-bit differences written back as varints and `f32`s).
+fn decoded(part: &Part) -> Vec<u8> {
+    let unzigzag = |v: u32| (v >> 1) as i32 ^ -((v & 1) as i32);
+    match part.0 & 0xff {
         0 => part.2.clone(),
-        _ => zstd::bulk::decompress(&part.2, part.1 as usize).unwrap(),
+        1 => zstd::bulk::decompress(&part.2, part.1 as usize).unwrap(),
+        2 => untranspose(
+            &zstd::bulk::decompress(&part.2, part.1 as usize).unwrap(),
+            usize::from(part.0 >> 8),
+        ),
+        _ => {
+            let rows = untranspose(
+                &zstd::bulk::decompress(&part.2, 2 * part.1 as usize).unwrap(),
+                12,
+            );
+            let mut out = Vec::new();
+            let mut prev = 0u32;
+            for row in rows.chunks_exact(12) {
+                let w = |i: usize| u32::from_le_bytes(row[i..i + 4].try_into().unwrap());
+                let kept = (w(0) as i32).wrapping_add(unzigzag(w(4))) as u32;
+                prev = (prev as i32).wrapping_add(unzigzag(w(8))) as u32;
+                put_varint(&mut out, u64::from(w(0)));
+                put_varint(&mut out, u64::from(kept));
+                out.extend_from_slice(&prev.to_le_bytes());
+            }
+            out
+        }
     }
 }
 
@@ -164,7 +210,8 @@ fn every_kind_of_model_round_trips_smaller() {
                 coded.len(),
                 plain.len()
             );
-            // Every section is the version-3 one, decoded.
+            // Every section is the version-3 one, decoded; the positions
+            // are coded transposed (rows of three f32).
             let plain_sections = sections(&plain);
             let coded_sections = sections(&coded);
             assert_eq!(coded_sections.len(), plain_sections.len());
@@ -174,6 +221,12 @@ fn every_kind_of_model_round_trips_smaller() {
                     let ps = parts(&c.2);
                     assert_eq!(ps.len(), 1);
                     assert_eq!(decoded(&ps[0]), p.2, "{name}: {:?}", c.0);
+                    if &c.0 == b"POSI" && p.2.len() > 10_000 {
+                        assert_eq!(ps[0].0, 2 | 12 << 8, "{name}");
+                    }
+                    if &c.0 == b"STEP" && p.2.len() > 10_000 {
+                        assert_eq!(ps[0].0, 3, "{name}: the steps by column");
+                    }
                 }
             }
         }
@@ -226,10 +279,10 @@ fn corrupt_and_truncated_files_are_errors_naming_the_section() {
     let mut s = sections(&good);
     let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
     let mut ps = parts(&s[modl].2);
-    assert_eq!(ps.len(), 5);
-    assert_eq!(ps[1].0, 1, "the vertices are coded");
-    let mid = ps[1].2.len() / 2;
-    ps[1].2[mid] ^= 0x5a;
+    assert_eq!(ps.len(), 6);
+    assert_eq!(ps[2].0, 1, "the vertices are coded");
+    let mid = ps[2].2.len() / 2;
+    ps[2].2[mid] ^= 0x5a;
     s[modl].2 = payload_of(&ps);
     let e = load(&file_of(&s)).unwrap_err();
     assert!(place(&e).0.starts_with("MODL"), "{e}");
@@ -266,9 +319,9 @@ fn amplifying_files_are_refused_before_allocating() {
     let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
     let original = parts(&s[modl].2);
     for (part, announced, says) in [
-        (2, 1u64 << 40, "more than 1024 × the file's"),
-        (2, original[2].1 - 1, "MODL"),
-        (3, original[3].1 + 1, "MODL"),
+        (3, 1u64 << 40, "more than 1024 × the file's"),
+        (3, original[3].1 - 1, "MODL"),
+        (4, original[4].1 + 1, "MODL"),
     ] {
         let mut ps = original.clone();
         ps[part].1 = announced;
@@ -284,7 +337,7 @@ fn amplifying_files_are_refused_before_allocating() {
     let posi = s.iter().position(|x| &x.0 == b"POSI").unwrap();
     let mut s = sections(&good);
     let mut ps = parts(&s[posi].2);
-    ps[0].1 = 1 << 40;
+    ps[0].1 = 12 << 40;
     s[posi].2 = payload_of(&ps);
     let e = load(&file_of(&s)).unwrap_err();
     assert!(e.to_string().contains("more than 1024 × the file's"), "{e}");
@@ -335,9 +388,9 @@ fn a_frame_that_decodes_to_far_more_is_refused() {
     let mut s = sections(&good);
     let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
     let original = parts(&s[modl].2);
-    for announced in [2048u64 << 17, original[2].1] {
+    for announced in [2048u64 << 17, original[3].1] {
         let mut ps = original.clone();
-        ps[2] = (1, announced, frame.clone());
+        ps[3] = (1, announced, frame.clone());
         s[modl].2 = payload_of(&ps);
         let bytes = file_of(&s);
         assert!(bytes.len() < 100_000);
@@ -362,7 +415,7 @@ fn coded_files_that_lie_meet_the_recipe_checks() {
     let s = sections(&good);
     let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
     let original = parts(&s[modl].2);
-    let vertices = decoded(&original[1]);
+    let vertices = decoded(&original[2]);
     let (mut refused, mut first_refused) = (0, 0);
     let tries = 80;
     for k in 0..tries {
@@ -373,7 +426,7 @@ fn coded_files_that_lie_meet_the_recipe_checks() {
         let x = u16::from_le_bytes([v[at], v[at + 1]]).wrapping_add(1);
         v[at..at + 2].copy_from_slice(&x.to_le_bytes());
         let mut ps = original.clone();
-        ps[1] = (1, v.len() as u64, zstd::bulk::compress(&v, 3).unwrap());
+        ps[2] = (1, v.len() as u64, zstd::bulk::compress(&v, 3).unwrap());
         let mut lie = s.clone();
         lie[modl].2 = payload_of(&ps);
         match load(&file_of(&lie)) {

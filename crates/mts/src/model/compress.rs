@@ -17,14 +17,19 @@
 //!
 //! Layout: the header and section table of version 3 ([`super::format`]),
 //! with the same seven tags; the checksum is of the coded body. Each
-//! section's payload is a varint part count (1, or 5 for `MODL`) and then
-//! per part: the coding (`u8`: 0 stored, 1 a Zstandard frame), a varint
-//! decoded length, a varint coded length and the coded bytes. A section's
-//! decoded parts, concatenated, are its version-3 payload, except that the
-//! `MODL` section's second part (the records' vertices) holds only the
-//! records that start a node (a node's later records hold vertex 0); the
-//! parts of `MODL` are its head (counts, widths, `u32` arrays), vertices,
-//! labels, codes, and tail (far arcs, LoD → triangle table).
+//! section's payload is a varint part count (1, or 6 for `MODL`) and then
+//! per part: the coding (`u8`: 0 stored, 1 a Zstandard frame, 2 a
+//! Zstandard frame of the bytes transposed, then the row width `u8`), a
+//! varint decoded length, a varint coded length and the coded bytes
+//! (coding 3 is the steps' own, [`STEPS`]). A
+//! section's decoded parts, concatenated, are its version-3 payload,
+//! except that the `MODL` section's vertices part holds only the records
+//! that start a node (a node's later records hold vertex 0); the parts of
+//! `MODL` are its counts and widths, its `u32` tables, the records'
+//! vertices, labels and codes, and its tail (far arcs, LoD → triangle
+//! table). The writer keeps, per part, the smallest of stored, coded,
+//! (for positions, tables and tail) coded transposed, and (for the steps)
+//! coded by column.
 //!
 //! **Decision: a file may decode to at most [`MAX_EXPANSION`] × its own
 //! bytes** in all, checked over every part's header before anything is
@@ -53,16 +58,107 @@ pub const DEFAULT_LEVEL: i32 = 17;
 
 const STORED: u8 = 0;
 const ZSTD: u8 = 1;
+/// A Zstandard frame of the part's bytes transposed: read as rows of a
+/// width (the `u8` after the coding), byte 0 of every row first, then
+/// byte 1, ... Numbers of one kind then put their like bytes (exponents,
+/// high bytes) side by side: the bunny's positions code 19% smaller, the
+/// `MODL` tables 45%, the LoD → triangle table 96%.
+const TRANSPOSED: u8 = 2;
+
+/// The contraction steps (`STEP`: per step the removed and kept vertices
+/// as varints and the error as `f32`) as rows of three `u32`, transposed
+/// (as [`TRANSPOSED`] with rows of 12 bytes), then a Zstandard frame: the
+/// removed vertex; the kept one's difference from it and the error's bits'
+/// difference from the step before, each zigzagged (`i32` wrapping). The
+/// bunny's steps code to 151 KB instead of 213 KB. The frame may decode to
+/// at most twice the part's announced length (a step is at least 6 bytes
+/// in the section, 12 as a row).
+const STEPS: u8 = 3;
+
+fn zigzag32(d: i32) -> u32 {
+    ((d << 1) ^ (d >> 31)) as u32
+}
+
+fn unzigzag32(v: u32) -> i32 {
+    (v >> 1) as i32 ^ -((v & 1) as i32)
+}
+
+/// The `STEP` payload `v3` as rows of three `u32` (see [`STEPS`]), or
+/// `None` if it is not a whole number of steps with `u32` vertices.
+fn steps_to_rows(v3: &[u8]) -> Option<Vec<u8>> {
+    let mut r = Reader::new(v3, 0, "STEP", std::path::Path::new(""));
+    let mut out = Vec::with_capacity(v3.len() * 2);
+    let mut prev = 0u32;
+    while r.remaining() > 0 {
+        let removed = u32::try_from(r.varint().ok()?).ok()?;
+        let kept = u32::try_from(r.varint().ok()?).ok()?;
+        let bits = r.f32().ok()?.to_bits();
+        let kept_d = zigzag32((kept as i32).wrapping_sub(removed as i32));
+        let error_d = zigzag32((bits as i32).wrapping_sub(prev as i32));
+        prev = bits;
+        for x in [removed, kept_d, error_d] {
+            out.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    Some(out)
+}
+
+/// The `STEP` payload of `rows` (the inverse of [`steps_to_rows`]).
+fn rows_to_steps(rows: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(rows.len());
+    let mut prev = 0u32;
+    for row in rows.chunks_exact(12) {
+        let word = |i: usize| u32::from_le_bytes([row[i], row[i + 1], row[i + 2], row[i + 3]]);
+        let removed = word(0);
+        let kept = (removed as i32).wrapping_add(unzigzag32(word(4))) as u32;
+        let bits = (prev as i32).wrapping_add(unzigzag32(word(8))) as u32;
+        prev = bits;
+        put_varint(&mut out, u64::from(removed));
+        put_varint(&mut out, u64::from(kept));
+        out.extend_from_slice(&bits.to_le_bytes());
+    }
+    out
+}
+
+/// `data` read as rows of `width` bytes, transposed (or back with
+/// `inverse`); its length is a multiple of `width`.
+fn transpose(data: &[u8], width: usize, inverse: bool) -> Vec<u8> {
+    let rows = data.len() / width;
+    let mut out = vec![0u8; data.len()];
+    for row in 0..rows {
+        for col in 0..width {
+            let (a, b) = (row * width + col, col * rows + row);
+            if inverse {
+                out[a] = data[b];
+            } else {
+                out[b] = data[a];
+            }
+        }
+    }
+    out
+}
 
 /// Parts of the `MODL` section.
-const MODL_PARTS: usize = 5;
+const MODL_PARTS: usize = 6;
 
 /// The names of the `MODL` section's parts, for errors.
-const MODL_PART_NAMES: [&str; MODL_PARTS] = ["head", "vertices", "labels", "codes", "tail"];
+const MODL_PART_NAMES: [&str; MODL_PARTS] =
+    ["counts", "tables", "vertices", "labels", "codes", "tail"];
 
-/// A part as written: its coding and bytes (the data itself where stored).
+/// The row width each part is tried transposed at ([`TRANSPOSED`]), in the
+/// order of [`super::format`]'s tags then the `MODL` parts: positions
+/// (three `f32`), the `MODL` tables (`u32`) and tail (`u32`); 0 for the
+/// others (varints, or columns whose bytes gain nothing).
+const ROW_WIDTHS: [u8; 6 + MODL_PARTS] = [0, 12, 0, 0, 0, 0, 0, 4, 0, 0, 0, 4];
+
+/// The index of the `STEP` section among the parts the writer codes.
+const STEP_PART: usize = 3;
+
+/// A part as written: its coding, row width (for [`TRANSPOSED`]) and
+/// bytes (the data itself where stored).
 struct Coded {
     coding: u8,
+    width: u8,
     frame: Vec<u8>,
 }
 
@@ -78,15 +174,51 @@ pub(crate) fn pack(recipe: &[Vec<u8>], modl: &[Vec<u8>; MODL_PARTS], level: i32)
     let mut coded = crate::parallel::map_indexed(
         parts.len(),
         || (),
-        |(), i| match zstd::bulk::compress(parts[i], level) {
-            Ok(f) if f.len() < parts[i].len() => Coded {
-                coding: ZSTD,
-                frame: f,
-            },
-            _ => Coded {
+        |(), i| {
+            let data = parts[i];
+            let mut best = Coded {
                 coding: STORED,
+                width: 0,
                 frame: Vec::new(),
-            },
+            };
+            let width = ROW_WIDTHS.get(i).copied().unwrap_or(0);
+            let mut tries = vec![(ZSTD, 0u8)];
+            if width > 0 && data.len() % usize::from(width) == 0 {
+                tries.push((TRANSPOSED, width));
+            }
+            let rows = if i == STEP_PART {
+                steps_to_rows(data)
+            } else {
+                None
+            };
+            if rows.is_some() {
+                tries.push((STEPS, 0));
+            }
+            for (coding, width) in tries {
+                let frame = match (coding, &rows) {
+                    (TRANSPOSED, _) => {
+                        zstd::bulk::compress(&transpose(data, usize::from(width), false), level)
+                    }
+                    (STEPS, Some(rows)) => zstd::bulk::compress(&transpose(rows, 12, false), level),
+                    _ => zstd::bulk::compress(data, level),
+                };
+                let size = if best.coding == STORED {
+                    data.len()
+                } else {
+                    best.frame.len()
+                };
+                match frame {
+                    Ok(f) if f.len() < size => {
+                        best = Coded {
+                            coding,
+                            width,
+                            frame: f,
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            best
         },
     );
     let size = |c: &Coded, p: &Vec<u8>| {
@@ -107,7 +239,7 @@ pub(crate) fn pack(recipe: &[Vec<u8>], modl: &[Vec<u8>; MODL_PARTS], level: i32)
             break;
         }
         let densest = (0..parts.len())
-            .filter(|&i| coded[i].coding == ZSTD)
+            .filter(|&i| coded[i].coding != STORED)
             .max_by_key(|&i| parts[i].len() / coded[i].frame.len().max(1));
         let Some(i) = densest else { break };
         coded[i].coding = STORED;
@@ -117,11 +249,14 @@ pub(crate) fn pack(recipe: &[Vec<u8>], modl: &[Vec<u8>; MODL_PARTS], level: i32)
         put_varint(&mut out, range.len() as u64);
         for i in range {
             out.push(coded[i].coding);
+            if coded[i].coding == TRANSPOSED {
+                out.push(coded[i].width);
+            }
             put_varint(&mut out, parts[i].len() as u64);
-            let bytes: &[u8] = if coded[i].coding == ZSTD {
-                &coded[i].frame
-            } else {
+            let bytes: &[u8] = if coded[i].coding == STORED {
                 parts[i]
+            } else {
+                &coded[i].frame
             };
             put_varint(&mut out, bytes.len() as u64);
             out.extend_from_slice(bytes);
@@ -156,8 +291,9 @@ pub(crate) fn check_expansion(sections: &[Reader<'_>], file_len: usize) -> Resul
             if total > budget {
                 r.pos = at;
                 return Err(r.error(format!(
-                    "{name}: the parts so far decode to {total} bytes, more than \
-                     {MAX_EXPANSION} × the file's {file_len}"
+                    "{}the parts so far decode to {total} bytes, more than {MAX_EXPANSION} × \
+                     the file's {file_len}",
+                    part_prefix(name, &r)
                 )));
             }
         }
@@ -182,6 +318,8 @@ pub(crate) struct Part<'a> {
     at: usize,
     name: &'static str,
     coding: u8,
+    /// The row width of a [`TRANSPOSED`] part (1 to 16), else 0.
+    width: u8,
     decoded: u64,
     bytes: &'a [u8],
 }
@@ -193,6 +331,7 @@ pub(crate) struct Part<'a> {
 fn next_part<'a>(r: &mut Reader<'a>, name: &'static str) -> Result<Part<'a>> {
     let at = r.pos;
     let coding = r.u8()?;
+    let width = if coding == TRANSPOSED { r.u8()? } else { 0 };
     let decoded = r.varint()?;
     let coded = r.count(&format!("{name}: coded length"), r.remaining() as u64)?;
     let all: &'a [u8] = r.bytes;
@@ -201,17 +340,23 @@ fn next_part<'a>(r: &mut Reader<'a>, name: &'static str) -> Result<Part<'a>> {
     let bytes = &all[start..start + coded];
     let problem = match coding {
         STORED if decoded != coded as u64 => Some(format!("stored, {coded} bytes for {decoded}")),
-        STORED | ZSTD => None,
-        c => Some(format!("coding {c}, not 0 (stored) or 1 (Zstandard)")),
+        TRANSPOSED if !(1..=16).contains(&width) || decoded % u64::from(width) != 0 => Some(
+            format!("transposed in rows of {width} bytes, which {decoded} bytes are not"),
+        ),
+        STORED | ZSTD | TRANSPOSED | STEPS => None,
+        c => Some(format!(
+            "coding {c}, not 0 (stored), 1 (Zstandard), 2 (transposed) or 3 (steps)"
+        )),
     };
     if let Some(p) = problem {
         r.pos = at;
-        return Err(r.error(format!("{name}: {p}")));
+        return Err(r.error(format!("{}{p}", part_prefix(name, r))));
     }
     Ok(Part {
         at,
         name,
         coding,
+        width,
         decoded,
         bytes,
     })
@@ -231,6 +376,9 @@ impl Part<'_> {
         let expected = bytes.len();
         let got = if self.decoded != expected as u64 {
             Err(format!("{} bytes, {expected} expected", self.decoded))
+        } else if self.coding == TRANSPOSED || self.coding == STEPS {
+            bytes.copy_from_slice(&self.decode(r)?);
+            Ok(())
         } else if self.coding == STORED {
             bytes.copy_from_slice(self.bytes);
             Ok(())
@@ -257,7 +405,7 @@ impl Part<'_> {
             Err(problem) => {
                 let mut at = r.clone();
                 at.pos = self.at;
-                Err(at.error(format!("{}: {problem}", self.name)))
+                Err(at.error(format!("{}{problem}", part_prefix(self.name, r))))
             }
         }
     }
@@ -276,7 +424,33 @@ impl Part<'_> {
             return Ok(self.bytes.to_vec());
         }
         let (decoded, coded) = (self.decoded, self.bytes.len());
+        if self.coding == STEPS {
+            let room = usize::try_from(decoded.saturating_mul(2)).unwrap_or(usize::MAX);
+            let problem = match zstd::bulk::decompress(self.bytes, room) {
+                Ok(rows) if rows.len() % 12 == 0 => {
+                    let steps = rows_to_steps(&transpose(&rows, 12, true));
+                    if steps.len() as u64 == decoded {
+                        return Ok(steps);
+                    }
+                    format!(
+                        "{} steps make {} bytes, {decoded} announced",
+                        rows.len() / 12,
+                        steps.len()
+                    )
+                }
+                Ok(rows) => format!("{} bytes of steps are not rows of 12", rows.len()),
+                Err(e) => {
+                    format!("the Zstandard frame of {coded} bytes of steps does not decode: {e}")
+                }
+            };
+            let mut at = r.clone();
+            at.pos = self.at;
+            return Err(at.error(format!("{}{problem}", part_prefix(self.name, r))));
+        }
         let problem = match zstd::bulk::decompress(self.bytes, decoded as usize) {
+            Ok(out) if out.len() as u64 == decoded && self.coding == TRANSPOSED => {
+                return Ok(transpose(&out, usize::from(self.width), true));
+            }
             Ok(out) if out.len() as u64 == decoded => return Ok(out),
             Ok(out) => format!(
                 "the Zstandard frame decodes to {} bytes, {decoded} announced",
@@ -289,7 +463,17 @@ impl Part<'_> {
         };
         let mut at = r.clone();
         at.pos = self.at;
-        Err(at.error(format!("{}: {problem}", self.name)))
+        Err(at.error(format!("{}{problem}", part_prefix(self.name, r))))
+    }
+}
+
+/// What names part `name` in an error of the section `r` reads: nothing
+/// for a section of one part (the error names the section).
+fn part_prefix(name: &str, r: &Reader<'_>) -> String {
+    if name == r.section {
+        String::new()
+    } else {
+        format!("{name}: ")
     }
 }
 
