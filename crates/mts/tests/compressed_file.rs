@@ -403,6 +403,31 @@ fn a_frame_that_decodes_to_far_more_is_refused() {
     }
 }
 
+/// The vertices part must hold one vertex per node start, as the codes
+/// say: one per record (a later record of a node among them) is refused
+/// before the arrays are filled (it read past the array before).
+#[test]
+fn a_vertex_per_record_is_refused() {
+    let good = small().to_compressed_bytes(9);
+    let mut s = sections(&good);
+    let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
+    let original = parts(&s[modl].2);
+    let codes = decoded(&original[4]);
+    let later = codes.iter().filter(|&&c| c & 0x80 != 0).count();
+    assert!(later > 0, "the torus has nodes of several arcs");
+    let vertices = decoded(&original[2]);
+    for extra in [2usize, 2 * later, 2 * later + 2] {
+        let mut v = vertices.clone();
+        v.extend(std::iter::repeat_n(0u8, extra));
+        let mut ps = original.clone();
+        ps[2] = (0, v.len() as u64, v);
+        s[modl].2 = payload_of(&ps);
+        let e = load(&file_of(&s)).unwrap_err();
+        assert!(e.to_string().contains("vertices:"), "{e}");
+        assert!(e.to_string().contains("start a node"), "{e}");
+    }
+}
+
 /// A ready file that lies (a decoded vertex changed, coded again, the file
 /// resealed) meets the same checks as version 3's: the first band's nodes
 /// born at LoD 0 (most of the first records) are walked on every load, so

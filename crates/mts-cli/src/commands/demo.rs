@@ -52,9 +52,11 @@ pub fn demo(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Resul
         model.band_count(),
         model.base_strips().run_count(),
     )?;
-    let file_bytes = model.to_bytes().len();
+    let file_bytes = model
+        .to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL)
+        .len();
     outln!(
-        ".mts file {file_bytes} bytes = {:.2} x the raw mesh (12 bytes per vertex + 12 per triangle)",
+        ".mts file {file_bytes} bytes = {:.2} x the raw mesh (12 bytes per vertex + 12 per triangle), as `mts build` writes it",
         file_bytes as f64 / model.raw_bytes() as f64
     )?;
     // A sweep from the coarsest LoD to the full mesh, one LoD at a time

@@ -31,14 +31,18 @@
 //! (for positions, tables and tail) coded transposed, and (for the steps)
 //! coded by column.
 //!
-//! **Decision: a file may decode to at most [`MAX_EXPANSION`] × its own
-//! bytes** in all, checked over every part's header before anything is
-//! decoded or allocated ([`check_expansion`]). Per file, not per part:
-//! a column can legitimately code a thousand to one (the companion section
-//! of a model without seams is one zero byte per step), while the
-//! positions, a fifth of the file, hardly shrink; the writer stores the
-//! densest parts plainly in the (never seen) case that the whole file
-//! would exceed the bound.
+//! **Decision: a file may ask loading to hold at most [`MAX_EXPANSION`] ×
+//! its own bytes** in all, checked over every part's header before
+//! anything is decoded or allocated ([`check_expansion`]): each part's
+//! announced length, weighted by what decoding it holds at once (3 for a
+//! transposed part: the frame's output, the part, a copy into its array;
+//! 6 for the steps' columns, whose rows may take twice the part; the
+//! `MODL` codes 5, for the vertex array of up to 4 bytes a record their
+//! count sizes). Per file, not per part: a column can legitimately code a
+//! thousand to one (the companion section of a model without seams is one
+//! zero byte per step), while the positions, a fifth of the file, hardly
+//! shrink; the writer stores the densest parts plainly in the (never seen)
+//! case that the whole file would exceed the bound.
 //!
 //! Loading decodes `MODL` on a second thread while the recipe's sections
 //! are decoded, then parses as version 3 does (every count, index and
@@ -47,7 +51,8 @@
 use super::format::{put_varint, Reader};
 use crate::error::Result;
 
-/// How many times its coded bytes a part may decode to.
+/// How many times its own bytes a file may ask loading to hold
+/// ([`check_expansion`]).
 pub(crate) const MAX_EXPANSION: u64 = 1024;
 
 /// The Zstandard level `mts build` writes at: the measured balance of size
@@ -103,11 +108,15 @@ fn steps_to_rows(v3: &[u8]) -> Option<Vec<u8>> {
     Some(out)
 }
 
-/// The `STEP` payload of `rows` (the inverse of [`steps_to_rows`]).
-fn rows_to_steps(rows: &[u8]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(rows.len());
+/// The `STEP` payload of `rows` (the inverse of [`steps_to_rows`]),
+/// written until it is longer than `limit` bytes (then it is wrong).
+fn rows_to_steps(rows: &[u8], limit: usize) -> Vec<u8> {
+    let mut out = Vec::with_capacity(rows.len().min(limit));
     let mut prev = 0u32;
     for row in rows.chunks_exact(12) {
+        if out.len() > limit {
+            break;
+        }
         let word = |i: usize| u32::from_le_bytes([row[i], row[i + 1], row[i + 2], row[i + 3]]);
         let removed = word(0);
         let kept = (removed as i32).wrapping_add(unzigzag32(word(4))) as u32;
@@ -222,10 +231,10 @@ pub(crate) fn pack(recipe: &[Vec<u8>], modl: &[Vec<u8>; MODL_PARTS], level: i32)
         },
     );
     let size = |c: &Coded, p: &Vec<u8>| {
-        if c.coding == ZSTD {
-            c.frame.len()
-        } else {
+        if c.coding == STORED {
             p.len()
+        } else {
+            c.frame.len()
         }
     };
     let decoded: u64 = parts.iter().map(|p| p.len() as u64).sum();
@@ -269,9 +278,9 @@ pub(crate) fn pack(recipe: &[Vec<u8>], modl: &[Vec<u8>; MODL_PARTS], level: i32)
 }
 
 /// Checks, before anything is decoded, that the parts of a version-5
-/// file's coded `sections` announce at most [`MAX_EXPANSION`] × `file_len`
-/// decoded bytes in all (each part's header checked as it is read), so a
-/// file asks for at most about a thousand times its own size.
+/// file's coded `sections` ask loading to hold at most [`MAX_EXPANSION`] ×
+/// `file_len` bytes in all: each part's announced length times
+/// [`holding`] (each part's header checked as it is read).
 pub(crate) fn check_expansion(sections: &[Reader<'_>], file_len: usize) -> Result<()> {
     let budget = MAX_EXPANSION * file_len as u64 + 64;
     let mut total = 0u64;
@@ -287,18 +296,29 @@ pub(crate) fn check_expansion(sections: &[Reader<'_>], file_len: usize) -> Resul
             let name = if expected == 1 { s.section } else { name };
             let at = r.pos;
             let part = next_part(&mut r, name)?;
-            total = total.saturating_add(part.decoded);
+            let weight = holding(part.coding) + if name == "codes" { 4 } else { 0 };
+            total = total.saturating_add(part.decoded.saturating_mul(weight));
             if total > budget {
                 r.pos = at;
                 return Err(r.error(format!(
-                    "{}the parts so far decode to {total} bytes, more than {MAX_EXPANSION} × \
-                     the file's {file_len}",
+                    "{}the parts so far would take {total} bytes to decode, more than \
+                     {MAX_EXPANSION} × the file's {file_len}",
                     part_prefix(name, &r)
                 )));
             }
         }
     }
     Ok(())
+}
+
+/// How many times its announced length decoding a part of `coding` holds
+/// at once, at most (see the module documentation).
+fn holding(coding: u8) -> u64 {
+    match coding {
+        TRANSPOSED => 3,
+        STEPS => 6,
+        _ => 1,
+    }
 }
 
 /// Reads the part count of the section `r` reads, which must be
@@ -417,8 +437,8 @@ impl Part<'_> {
     }
 
     /// The decoded bytes, into a buffer of the announced length at most
-    /// (the decoder stops where it would need more). `r` (the section's
-    /// reader) places errors.
+    /// (the decoder stops where it would need more; twice that for the
+    /// steps' rows, [`STEPS`]). `r` (the section's reader) places errors.
     pub(crate) fn decode(&self, r: &Reader<'_>) -> Result<Vec<u8>> {
         if self.coding == STORED {
             return Ok(self.bytes.to_vec());
@@ -428,7 +448,7 @@ impl Part<'_> {
             let room = usize::try_from(decoded.saturating_mul(2)).unwrap_or(usize::MAX);
             let problem = match zstd::bulk::decompress(self.bytes, room) {
                 Ok(rows) if rows.len() % 12 == 0 => {
-                    let steps = rows_to_steps(&transpose(&rows, 12, true));
+                    let steps = rows_to_steps(&transpose(&rows, 12, true), decoded as usize);
                     if steps.len() as u64 == decoded {
                         return Ok(steps);
                     }
@@ -516,4 +536,53 @@ pub(crate) fn modl_parts<'a>(r: &mut Reader<'a>) -> Result<Vec<Part<'a>>> {
         .collect::<Result<Vec<_>>>()?;
     r.finish()?;
     Ok(parts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transposing_and_back_gives_the_bytes() {
+        let data: Vec<u8> = (0..96u8).collect();
+        for width in [1, 2, 4, 12, 16] {
+            let t = transpose(&data, width, false);
+            assert_eq!(transpose(&t, width, true), data, "width {width}");
+        }
+        // Rows of 4: the first byte of every row first.
+        assert_eq!(&transpose(&data[..8], 4, false), &[0, 4, 1, 5, 2, 6, 3, 7]);
+    }
+
+    /// Steps whose differences wrap (vertex 0 kept for vertex 2^32 - 1,
+    /// errors that fall, a NaN's bits): the rows give the section back
+    /// byte for byte.
+    #[test]
+    fn steps_by_column_give_the_section_back() {
+        let mut v3 = Vec::new();
+        for (removed, kept, error) in [
+            (5u64, 7u64, 0.0f32),
+            (u64::from(u32::MAX), 0, 1.5),
+            (0, u64::from(u32::MAX), -2.0),
+            (300, 299, f32::NAN),
+            (1, 2, f32::MAX),
+        ] {
+            put_varint(&mut v3, removed);
+            put_varint(&mut v3, kept);
+            v3.extend_from_slice(&error.to_le_bytes());
+        }
+        let rows = steps_to_rows(&v3).unwrap();
+        assert_eq!(rows.len(), 5 * 12);
+        assert_eq!(rows_to_steps(&rows, v3.len()), v3);
+        assert!(
+            rows_to_steps(&rows, 3).len() < v3.len(),
+            "stops past the limit"
+        );
+        // Not a whole number of steps, or a vertex past u32: not coded so.
+        assert_eq!(steps_to_rows(&v3[..v3.len() - 1]), None);
+        let mut wide = Vec::new();
+        put_varint(&mut wide, 1 << 32);
+        put_varint(&mut wide, 0);
+        wide.extend_from_slice(&0f32.to_le_bytes());
+        assert_eq!(steps_to_rows(&wide), None);
+    }
 }

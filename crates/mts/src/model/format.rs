@@ -19,7 +19,7 @@
 //!
 //! The checksum is of every byte after the header: FNV-1a (64 bit) in
 //! versions 1 and 2, its four-lane word form
-//! ([`crate::checksum::fnv1a64_words`]) in version 3. Sections, in this
+//! ([`crate::checksum::fnv1a64_words`]) from version 3 on. Sections, in this
 //! order:
 //! - `META`: varints vertex count, appended vertex count, run count, strip
 //!   index count, step count; then band slack (f64), the band stripifier's
@@ -61,8 +61,9 @@
 //! Version 5 ([`COMPRESSED_VERSION`], what `mts build` writes) is version 3
 //! with each section's payload coded with Zstandard, `MODL` in six
 //! parts ([`super::compress`]): about a third of version 3's bytes (the
-//! bunny: 2.1 MB against 7.2 MB, 1.71 × the raw mesh), decoded and then
-//! checked exactly as version 3.
+//! bunny: 2.1 MB against 7.2 MB, 1.71 × the raw mesh), decoded, then
+//! checked as version 3 (the `MODL` head's counts against the decoded
+//! parts' lengths instead of the section's). Its checksum is version 3's.
 
 use super::records::Narrow;
 use super::{build, BuildOptions, MtsModel};
@@ -103,11 +104,12 @@ fn section_count(version: u32) -> usize {
 }
 
 /// What an `.mts` file holds, by its version: a per-object model
-/// (versions 1 to 3) or a view-dependent hierarchy (version 4,
+/// (versions 1 to 3 and 5) or a view-dependent hierarchy (version 4,
 /// [`crate::hierarchy::Hierarchy`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Holds {
-    /// An [`MtsModel`] (versions 1 to [`VERSION`]).
+    /// An [`MtsModel`] (versions 1 to [`VERSION`], and
+    /// [`COMPRESSED_VERSION`]).
     Model,
     /// A [`crate::hierarchy::Hierarchy`] (version
     /// [`crate::hierarchy::format::VERSION`]).
@@ -421,7 +423,7 @@ fn read_coded_model(bytes: &[u8], file: &Path) -> Result<MtsModel> {
         return Err(top.error("no MODL section"));
     };
     // The step count (META's fifth varint), bounded as `parse_model`
-    // bounds it (6 bytes a step at least); a wrong one fails there first.
+    // bounds it (6 bytes a step at least, of the decoded STEP section).
     let (r, meta) = only_part(&coded[0])?;
     let meta = meta.decode(&r)?;
     let mut m = Reader::new(&meta, 0, "META, decoded", file);
@@ -1149,9 +1151,6 @@ fn parse_model(s: ModelSections<'_>, threaded: bool) -> Result<Parsed<'_>> {
     })
 }
 
-/// Reads the `MODL` section into the model `parsed` describes. Every count
-/// is bounded by the bytes left before anything is allocated; the
-/// structure is checked afterwards by [`MtsModel::validate`].
 /// The graph arrays of the `MODL` section, before they join the recipe.
 pub(crate) struct Arrays {
     strip_records: Vec<u32>,
@@ -1194,11 +1193,12 @@ fn read_arrays(mut r: Reader<'_>, max_lod: usize) -> Result<Arrays> {
 }
 
 /// The arrays of a version-5 `MODL` section `m` (see [`super::compress`]):
-/// the head decoded and checked first, then the records' columns decoded
-/// straight into their arrays (the vertices on a second thread), each
-/// part's length checked against the head's counts, and the vertices of the
-/// records that start a node spread back over every record (0 on a node's
-/// later records).
+/// the head decoded and checked first, then the codes, which say how many
+/// records start a node; every other part's announced length is checked
+/// against those counts before its array is allocated; the columns are
+/// decoded straight into their arrays (the vertices on a second thread),
+/// and the vertices of the records that start a node spread back over
+/// every record (0 on a node's later records).
 fn read_coded_arrays(mut m: Reader<'_>, max_lod: usize) -> Result<Arrays> {
     use super::compress::modl_parts;
     let parts = modl_parts(&mut m)?;
@@ -1216,42 +1216,62 @@ fn read_coded_arrays(mut m: Reader<'_>, max_lod: usize) -> Result<Arrays> {
     )?;
     let records = head.records;
     let (vw, lw) = (head.vertex_width, head.label_width);
-    // The vertices' part holds those of the node starts, counted below.
-    let stored = usize::try_from(vertices.decoded_len()).unwrap_or(usize::MAX) / vw;
-    if stored > records {
-        return Err(m.error(format!(
-            "vertices: {} bytes for at most {records} nodes of {vw} bytes",
-            vertices.decoded_len()
-        )));
+    // The codes first: they say which records start a node, and so what
+    // the vertices' part must hold, before the other arrays are allocated.
+    let mut rec_code = vec![0u8; records];
+    codes.decode_into(m, &mut rec_code, u8::from_le)?;
+    let starts = match records {
+        0 => 0,
+        n => {
+            1 + rec_code[..n - 1]
+                .iter()
+                .filter(|&&c| c & super::records::MORE == 0)
+                .count()
+        }
+    };
+    for (part, name, expected) in [
+        (vertices, "vertices", vw * starts),
+        (labels, "labels", lw * records),
+    ] {
+        if part.decoded_len() != expected as u64 {
+            return Err(m.error(format!(
+                "{name}: {} bytes announced, {expected} for {records} records of which \
+                 {starts} start a node",
+                part.decoded_len()
+            )));
+        }
     }
-    fn spread<T: Copy + Default>(v: &mut [T], codes: &[u8], stored: usize) -> bool {
-        // Backwards, so that a value moves to its record (never before its
-        // own index) before that index is written; a select, not a branch.
-        let (mut k, mut short) = (stored, false);
+    /// Spreads the `starts` node vertices at the front of `v` over its
+    /// records, backwards, so that a value moves to its record (never
+    /// before its own index) before that index is written; a select, not a
+    /// branch. `k` stays in range: it only falls below `v.len()` as node
+    /// starts are met, and `starts` counts them all.
+    fn spread<T: Copy + Default>(v: &mut [T], codes: &[u8], starts: usize) {
+        let mut k = starts;
         for r in (0..v.len()).rev() {
             let s = r == 0 || codes[r - 1] & super::records::MORE == 0;
-            short |= s && k == 0;
-            k = k.saturating_sub(usize::from(s));
-            let x = v[k];
+            k -= usize::from(s);
+            let x = v[k.min(r)];
             v[r] = if s { x } else { T::default() };
         }
-        !short && k == 0
+        debug_assert_eq!(k, 0);
     }
+    let code = &rec_code;
     let (rec_vertex, rest) = std::thread::scope(|scope| {
         let vertex_part = scope.spawn(move || -> Result<Narrow> {
             Ok(if vw == 2 {
                 let mut v = vec![0u16; records];
-                vertices.decode_into(m, &mut v[..stored], u16::from_le)?;
+                vertices.decode_into(m, &mut v[..starts], u16::from_le)?;
+                spread(&mut v, code, starts);
                 Narrow::U16(v)
             } else {
                 let mut v = vec![0u32; records];
-                vertices.decode_into(m, &mut v[..stored], u32::from_le)?;
+                vertices.decode_into(m, &mut v[..starts], u32::from_le)?;
+                spread(&mut v, code, starts);
                 Narrow::U32(v)
             })
         });
-        let rest = (|| -> Result<(Narrow, Vec<u8>, Vec<u8>)> {
-            let mut rec_code = vec![0u8; records];
-            codes.decode_into(m, &mut rec_code, u8::from_le)?;
+        let rest = (|| -> Result<(Narrow, Vec<u8>)> {
             let rec_label = if lw == 2 {
                 let mut v = vec![0u16; records];
                 labels.decode_into(m, &mut v, u16::from_le)?;
@@ -1261,23 +1281,14 @@ fn read_coded_arrays(mut m: Reader<'_>, max_lod: usize) -> Result<Arrays> {
                 labels.decode_into(m, &mut v, u32::from_le)?;
                 Narrow::U32(v)
             };
-            Ok((rec_label, rec_code, tail.decode(m)?))
+            Ok((rec_label, tail.decode(m)?))
         })();
         let v = vertex_part
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
         (v, rest)
     });
-    let (mut rec_vertex, (rec_label, rec_code, tail)) = (rec_vertex?, rest?);
-    let spread_all = match &mut rec_vertex {
-        Narrow::U16(v) => spread(v, &rec_code, stored),
-        Narrow::U32(v) => spread(v, &rec_code, stored),
-    };
-    if !spread_all {
-        return Err(m.error(format!(
-            "vertices: {stored} values for another number of nodes"
-        )));
-    }
+    let (rec_vertex, (rec_label, tail)) = (rec_vertex?, rest?);
     let mut t = Reader::new(&tail, 0, "MODL tail, decoded", &m.file);
     let far = read_far(&mut t, head.far, max_lod)?;
     Ok(head.with_records(rec_vertex, rec_label, rec_code, far))
@@ -1322,7 +1333,7 @@ impl Head {
     }
 }
 
-/// Reads a `MODL` section's head from `r`. Version 3 (`records` `None`):
+/// Reads a `MODL` section's head from `r`. Version 3 (`coded` `None`):
 /// the counts must account for every byte of `r`, records and tail
 /// included; version 5 (`coded`: the bytes the codes' and the tail's parts
 /// announce): the head is its own part, the record count must be the

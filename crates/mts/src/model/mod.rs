@@ -633,6 +633,14 @@ fn check_records<V: Word, L: Word>(
                 vertex[r].get()
             ));
         }
+        // A node's later records hold vertex 0 (the coded file stores the
+        // node starts' only, so a model that loads is one it writes).
+        if !node_start && vertex[r].get() != 0 {
+            return Err(format!(
+                "record {r}, a node's later arc, names vertex {}",
+                vertex[r].get()
+            ));
+        }
         if c == NO_ARC {
             if !node_start {
                 return Err(format!("record {r}: a node's later arc has no target"));
