@@ -21,7 +21,7 @@
 //! per part: the coding (`u8`: 0 stored, 1 a Zstandard frame, 2 a
 //! Zstandard frame of the bytes transposed, then the row width `u8`), a
 //! varint decoded length, a varint coded length and the coded bytes
-//! (coding 3 is the steps' own, [`STEPS`]). A
+//! (coding 3 is the steps' own, `STEPS`). A
 //! section's decoded parts, concatenated, are its version-3 payload,
 //! except that the `MODL` section's vertices part holds only the records
 //! that start a node (a node's later records hold vertex 0); the parts of
@@ -31,9 +31,9 @@
 //! (for positions, tables and tail) coded transposed, and (for the steps)
 //! coded by column.
 //!
-//! **Decision: a file may ask loading to hold at most [`MAX_EXPANSION`] ×
+//! **Decision: a file may ask loading to hold at most `MAX_EXPANSION` ×
 //! its own bytes** in all, checked over every part's header before
-//! anything is decoded or allocated ([`check_expansion`]): each part's
+//! anything is decoded or allocated (`check_expansion`): each part's
 //! announced length, weighted by what decoding it holds at once (3 for a
 //! transposed part: the frame's output, the part, a copy into its array;
 //! 6 for the steps' columns, whose rows may take twice the part; the
@@ -278,7 +278,7 @@ pub(crate) fn pack(recipe: &[Vec<u8>], modl: &[Vec<u8>; MODL_PARTS], level: i32)
 }
 
 /// Checks, before anything is decoded, that the parts of a version-5
-/// file's coded `sections` ask loading to hold at most [`MAX_EXPANSION`] ×
+/// file's coded `sections` ask loading to hold at most `MAX_EXPANSION` ×
 /// `file_len` bytes in all: each part's announced length times
 /// [`holding`] (each part's header checked as it is read).
 pub(crate) fn check_expansion(sections: &[Reader<'_>], file_len: usize) -> Result<()> {
