@@ -3647,10 +3647,16 @@ def hier_edit(rng, f, kind):
     raise ValueError(kind)
 
 
-def gen_hier(rng, seeds, index, quick=False):
-    name = HIER_SEEDS[index % len(HIER_SEEDS)]
-    full = seeds.v4[name]
-    kind = HIER_KINDS[index % len(HIER_KINDS)] if quick else rng.choice(HIER_KINDS)
+def structured_case(rng, family, seeds, names, kinds, unknown, parse, edit, index, quick):
+    """A case of a family of whole files taken apart (hier, coded): seed
+    `names[index]` from `seeds`, one of `kinds` (truncate, flip,
+    reseal_flip, clean, or an edit of the file `parse` gives, resealed);
+    returns the case, its expectation and a judge for runs after `verify`
+    (a possibly valid edit that verify refuses but another command loads is
+    a "trusted lie", counted apart, as in the reseal family)."""
+    name = names[index % len(names)]
+    full = seeds[name]
+    kind = kinds[index % len(kinds)] if quick else rng.choice(kinds)
     label, data = kind, None
     if kind == "truncate":
         data = truncate(rng, full)
@@ -3660,26 +3666,32 @@ def gen_hier(rng, seeds, index, quick=False):
         data = seal_mts(flip(rng, full, start=MTS_HEADER)[0])
     elif kind != "clean":
         for _ in range(20):
-            f = V4File(full)
-            label = hier_edit(rng, f, kind)
+            f = parse(full)
+            label = edit(rng, f, kind)
             if label:
                 data = f.to_bytes()
                 break
     if data is None:
         kind = label = "clean"
         data = full
-    expect = ACCEPT if kind == "clean" else UNKNOWN if kind in HIER_UNKNOWN else GARBAGE
-    case = Case("hier", "%s/%s:%s" % (kind, name[:-4], label), ".mts", data)
-    # verify decides whether a possibly valid edit lies (a crack, a group's
-    # model against its replay): one that info loads is then a "trusted
-    # lie", counted apart, as in the reseal family.
-    case.run(["verify", "{in}", "--lods", "2"], expect)
+    expect = ACCEPT if kind == "clean" else UNKNOWN if kind in unknown else GARBAGE
+    case = Case(family, "%s/%s:%s" % (kind, name[:-4], label), ".mts", data)
     refused = ("clean error", "unnamed error", "valid refused", "wrong message")
 
     def by_verify(prev):
         if expect != UNKNOWN:
             return expect
         return TRUSTED if prev[0]["cls"] in refused else UNKNOWN
+
+    return case, expect, by_verify
+
+
+def gen_hier(rng, seeds, index, quick=False):
+    case, expect, by_verify = structured_case(rng, "hier", seeds.v4, HIER_SEEDS, HIER_KINDS, HIER_UNKNOWN,
+                                              V4File, hier_edit, index, quick)
+    # verify decides whether a possibly valid edit lies (a crack, a group's
+    # model against its replay).
+    case.run(["verify", "{in}", "--lods", "2"], expect)
 
     case.run(["info", "{in}", "--json"] if rng.random() < 0.3 else ["info", "{in}"], by_verify)
     # A hierarchy is not a model: the model's commands refuse every one.
@@ -3858,35 +3870,9 @@ def coded_edit(rng, f, kind):
 
 
 def gen_coded(rng, seeds, index, quick=False):
-    name = CODED_SEEDS[index % len(CODED_SEEDS)]
-    full = seeds.v5[name]
-    kind = CODED_KINDS[index % len(CODED_KINDS)] if quick else rng.choice(CODED_KINDS)
-    label, data = kind, None
-    if kind == "truncate":
-        data = truncate(rng, full)
-    elif kind == "flip":
-        data, _ = flip(rng, full)
-    elif kind == "reseal_flip":
-        data = seal_mts(flip(rng, full, start=MTS_HEADER)[0])
-    elif kind != "clean":
-        for _ in range(20):
-            f = V5File(full)
-            label = coded_edit(rng, f, kind)
-            if label:
-                data = f.to_bytes()
-                break
-    if data is None:
-        kind = label = "clean"
-        data = full
-    expect = ACCEPT if kind == "clean" else UNKNOWN if kind in CODED_UNKNOWN else GARBAGE
-    case = Case("coded", "%s/%s:%s" % (kind, name[:-4], label), ".mts", data)
+    case, expect, by_verify = structured_case(rng, "coded", seeds.v5, CODED_SEEDS, CODED_KINDS, CODED_UNKNOWN,
+                                              V5File, coded_edit, index, quick)
     case.run(["verify", "{in}", "--lods", "4"], expect)
-    refused = ("clean error", "unnamed error", "valid refused", "wrong message")
-
-    def by_verify(prev):
-        if expect != UNKNOWN:
-            return expect
-        return TRUSTED if prev[0]["cls"] in refused else UNKNOWN
 
     case.run(["info", "{in}", "--json"] if rng.random() < 0.3 else ["info", "{in}"], by_verify)
     case.run(rng.choice([["extract", "{in}", "--lod", "0", "--repeat", "1"],
