@@ -3430,6 +3430,26 @@ def gen_reseal(rng, seeds, index, quick=False):
 # --- version-4 files: hierarchies ---------------------------------------------
 
 
+def split_mts_sections(data, version, tags):
+    """An .mts file of `version` with exactly the sections `tags` in order,
+    as [tag, payload] pairs; ValueError otherwise."""
+    found, count = struct.unpack_from("<II", data, 8)
+    if found != version or count != len(tags):
+        raise ValueError("not a version-%d file" % version)
+    pos = MTS_HEADER
+    sections = []
+    for _ in range(count):
+        tag = bytes(data[pos : pos + 4])
+        n = struct.unpack_from("<Q", data, pos + 4)[0]
+        sections.append([tag, bytes(data[pos + 12 : pos + 12 + n])])
+        pos += 12 + n
+    if pos != len(data):
+        raise ValueError("sections do not end at the end of the file")
+    if [t for t, _ in sections] != tags:
+        raise ValueError("sections %s" % [t for t, _ in sections])
+    return sections
+
+
 class V4File:
     """A version-4 .mts file (a hierarchy, crates/mts/src/hierarchy/format.rs)
     cut into sections, its HIER counts decoded and its GRPS section cut into
@@ -3439,19 +3459,7 @@ class V4File:
 
     def __init__(self, data):
         self.version, count = struct.unpack_from("<II", data, 8)
-        if self.version != 4 or count != 6:
-            raise ValueError("not a version-4 file")
-        pos = MTS_HEADER
-        self.sections = []
-        for _ in range(count):
-            tag = bytes(data[pos : pos + 4])
-            n = struct.unpack_from("<Q", data, pos + 4)[0]
-            self.sections.append([tag, bytes(data[pos + 12 : pos + 12 + n])])
-            pos += 12 + n
-        if pos != len(data):
-            raise ValueError("sections do not end at the end of the file")
-        if [t for t, _ in self.sections] != self.TAGS:
-            raise ValueError("sections %s" % [t for t, _ in self.sections])
+        self.sections = split_mts_sections(data, 4, self.TAGS)
         hier = self.sections[0][1]
         p = 0
         self.counts = []
@@ -3715,14 +3723,8 @@ class V5File:
 
     def __init__(self, data):
         self.version, count = struct.unpack_from("<II", data, 8)
-        if self.version != 5 or count != 7:
-            raise ValueError("not a version-5 file")
-        pos = MTS_HEADER
         self.sections = []
-        for _ in range(count):
-            tag = bytes(data[pos : pos + 4])
-            n = struct.unpack_from("<Q", data, pos + 4)[0]
-            payload = bytes(data[pos + 12 : pos + 12 + n])
+        for tag, payload in split_mts_sections(data, 5, self.TAGS):
             p = 0
             k, p = get_varint(payload, p)
             parts = []
@@ -3740,11 +3742,6 @@ class V5File:
             if p != len(payload):
                 raise ValueError("section %s: parts end at %d of %d" % (tag, p, len(payload)))
             self.sections.append([tag, parts])
-            pos += 12 + n
-        if pos != len(data):
-            raise ValueError("sections do not end at the end of the file")
-        if [t for t, _ in self.sections] != self.TAGS:
-            raise ValueError("sections %s" % [t for t, _ in self.sections])
         self.count_override = {}
         self.section_count = count
         self.trailing = b""

@@ -157,6 +157,16 @@ fn decoded(part: &Part) -> Vec<u8> {
     }
 }
 
+/// A file's sections, the index of `MODL` among them and its parts.
+type Taken = (Vec<([u8; 4], usize, Vec<u8>)>, usize, Vec<Part>);
+
+fn modl_of(bytes: &[u8]) -> Taken {
+    let s = sections(bytes);
+    let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
+    let parts = parts(&s[modl].2);
+    (s, modl, parts)
+}
+
 fn load(bytes: &[u8]) -> mts::Result<MtsModel> {
     MtsModel::from_bytes(bytes, Path::new("coded.mts"))
 }
@@ -276,9 +286,7 @@ fn corrupt_and_truncated_files_are_errors_naming_the_section() {
     assert_eq!(place(&load(&b).unwrap_err()), ("header".into(), 24));
     // A byte of the vertices' frame flipped and resealed: the frame does
     // not decode, or decodes to something the checks refuse.
-    let mut s = sections(&good);
-    let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
-    let mut ps = parts(&s[modl].2);
+    let (mut s, modl, mut ps) = modl_of(&good);
     assert_eq!(ps.len(), 6);
     assert_eq!(ps[2].0, 1, "the vertices are coded");
     let mid = ps[2].2.len() / 2;
@@ -315,9 +323,7 @@ fn corrupt_and_truncated_files_are_errors_naming_the_section() {
 #[test]
 fn amplifying_files_are_refused_before_allocating() {
     let good = small().to_compressed_bytes(9);
-    let mut s = sections(&good);
-    let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
-    let original = parts(&s[modl].2);
+    let (mut s, modl, original) = modl_of(&good);
     for (part, announced, says) in [
         (3, 1u64 << 40, "more than 1024 × the file's"),
         (3, original[3].1 - 1, "MODL"),
@@ -385,9 +391,7 @@ fn a_frame_that_decodes_to_far_more_is_refused() {
         "the hand-made frame is one Zstandard decodes"
     );
     let good = small().to_compressed_bytes(9);
-    let mut s = sections(&good);
-    let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
-    let original = parts(&s[modl].2);
+    let (mut s, modl, original) = modl_of(&good);
     for announced in [2048u64 << 17, original[3].1] {
         let mut ps = original.clone();
         ps[3] = (1, announced, frame.clone());
@@ -409,9 +413,7 @@ fn a_frame_that_decodes_to_far_more_is_refused() {
 #[test]
 fn a_vertex_per_record_is_refused() {
     let good = small().to_compressed_bytes(9);
-    let mut s = sections(&good);
-    let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
-    let original = parts(&s[modl].2);
+    let (mut s, modl, original) = modl_of(&good);
     let codes = decoded(&original[4]);
     let later = codes.iter().filter(|&&c| c & 0x80 != 0).count();
     assert!(later > 0, "the torus has nodes of several arcs");
@@ -437,9 +439,7 @@ fn a_vertex_per_record_is_refused() {
 fn coded_files_that_lie_meet_the_recipe_checks() {
     let m = small();
     let good = m.to_compressed_bytes(9);
-    let s = sections(&good);
-    let modl = s.iter().position(|x| &x.0 == b"MODL").unwrap();
-    let original = parts(&s[modl].2);
+    let (s, modl, original) = modl_of(&good);
     let vertices = decoded(&original[2]);
     let (mut refused, mut first_refused) = (0, 0);
     let tries = 80;

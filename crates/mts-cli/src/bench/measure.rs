@@ -624,9 +624,8 @@ fn measure_model(
 ) -> Result<(Model, MtsModel)> {
     let (model, _, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-    let file_bytes = model
-        .to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL)
-        .len();
+    let coded = model.to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL);
+    let file_bytes = coded.len();
     let stats = model.stats();
     // Struct fields are evaluated as written: the sections run in this
     // order.
@@ -656,7 +655,7 @@ fn measure_model(
         extraction: measure_sequences(&model, requests),
         levels: measure_levels(&model),
         quality: measure_quality(mesh, &model),
-        methods: super::methods::measure_methods(&model, mesh, ms(t.total), requests)?,
+        methods: super::methods::measure_methods(&model, mesh, ms(t.total), requests, &coded)?,
         figure6: match renderer {
             Ok(r) => Some(r.measure(&model, mesh, shares, frames)?),
             Err(_) => {

@@ -422,11 +422,7 @@ impl Part<'_> {
                 }
                 Ok(())
             }
-            Err(problem) => {
-                let mut at = r.clone();
-                at.pos = self.at;
-                Err(at.error(format!("{}{problem}", part_prefix(self.name, r))))
-            }
+            Err(problem) => Err(self.error(r, &problem)),
         }
     }
 
@@ -463,9 +459,7 @@ impl Part<'_> {
                     format!("the Zstandard frame of {coded} bytes of steps does not decode: {e}")
                 }
             };
-            let mut at = r.clone();
-            at.pos = self.at;
-            return Err(at.error(format!("{}{problem}", part_prefix(self.name, r))));
+            return Err(self.error(r, &problem));
         }
         let problem = match zstd::bulk::decompress(self.bytes, decoded as usize) {
             Ok(out) if out.len() as u64 == decoded && self.coding == TRANSPOSED => {
@@ -481,9 +475,15 @@ impl Part<'_> {
                  announced: {e}"
             ),
         };
+        Err(self.error(r, &problem))
+    }
+
+    /// `problem` as an error at the part's header in the section `r`
+    /// reads.
+    fn error(&self, r: &Reader<'_>, problem: &str) -> crate::Error {
         let mut at = r.clone();
         at.pos = self.at;
-        Err(at.error(format!("{}{problem}", part_prefix(self.name, r))))
+        at.error(format!("{}{problem}", part_prefix(self.name, r)))
     }
 }
 
