@@ -3724,7 +3724,10 @@ class V5File:
     def __init__(self, data):
         self.version, count = struct.unpack_from("<II", data, 8)
         self.sections = []
-        for tag, payload in split_mts_sections(data, 5, self.TAGS):
+        # Version 6 (crates/mts/src/model/prefix.rs): version 5 with coarse
+        # chunks first, PRFX sections of one part each.
+        tags = [b"PRFX"] * (count - len(self.TAGS)) + self.TAGS if self.version == 6 else self.TAGS
+        for tag, payload in split_mts_sections(data, self.version if self.version == 6 else 5, tags):
             p = 0
             k, p = get_varint(payload, p)
             parts = []
@@ -3777,7 +3780,7 @@ def zstd_rle_frame(blocks, byte=0):
     return bytes(out)
 
 
-CODED_SEEDS = ("torus_v5.mts", "ico_optimal_v5.mts", "torus_props_v5.mts")
+CODED_SEEDS = ("torus_v5.mts", "ico_optimal_v5.mts", "torus_props_v5.mts", "torus_v6.mts", "torus_props_v6.mts")
 CODED_KINDS = ["truncate", "flip", "reseal_flip", "part_count", "decoded_len", "decoded_huge", "coding",
                "stored_lie", "frame_flip", "frame_cut", "parts_swapped", "bomb", "bomb_honest", "section_count",
                "trailing", "width", "width_claimed", "clean"]
@@ -3844,7 +3847,7 @@ def coded_edit(rng, f, kind):
         p[2] = bytes(data)
         return "%s.%d" % (f.sections[a][0].decode(), b)
     if kind == "parts_swapped":
-        modl = f.sections[6][1]
+        modl = [ps for t, ps in f.sections if t == b"MODL"][0]
         a, b = rng.sample(range(len(modl)), 2)
         modl[a], modl[b] = modl[b], modl[a]
         return "MODL.%d<->%d" % (a, b)
@@ -3874,6 +3877,20 @@ def gen_coded(rng, seeds, index, quick=False):
     case.run(["info", "{in}", "--json"] if rng.random() < 0.3 else ["info", "{in}"], by_verify)
     case.run(rng.choice([["extract", "{in}", "--lod", "0", "--repeat", "1"],
                          ["extract", "{in}", "--ratio", "0.5", "--repeat", "1", "--json"]]), by_verify)
+    if len(case.data) > MTS_HEADER and case.data[8] == 6:
+        # A prefix of a version-6 file, as a reader opens it while the file
+        # arrives: a clean one opens from its first chunk's end on (and is
+        # refused, naming the file, before); an edited one may hold intact
+        # chunks, so any clean outcome will do.
+        n = rng.randrange(len(case.data) + 1)
+        first_end = None
+        if len(case.data) >= MTS_HEADER + 12 and case.data[MTS_HEADER:MTS_HEADER + 4] == b"PRFX":
+            first_end = MTS_HEADER + 12 + struct.unpack_from("<Q", case.data, MTS_HEADER + 4)[0]
+        if expect == ACCEPT and first_end is not None:
+            prefix_expect = ACCEPT if n >= first_end else GARBAGE
+        else:
+            prefix_expect = UNKNOWN
+        case.run(["extract", "{in}", "--bytes", str(n), "--ratio", "0.05", "--repeat", "1"], prefix_expect)
     return case
 
 
@@ -3911,10 +3928,13 @@ def make_seeds(mts_bin, root, timeout):
         # The reseal family's (issue 31): a single band, and properties.
         "grid_single_v3.mts": ["build", "--generated", "grid:60", "--single-band", "--uncompressed", "-o"],
         "torus_props_v3.mts": ["build", "--generated", "torus:300", "--properties", "--uncompressed", "-o"],
-        # The coded family's (issue 34): version 5, what `mts build` writes.
-        "torus_v5.mts": ["build", "--generated", "torus:300", "-o"],
+        # The coded family's (issue 34): version 5 (no chunk), and version 6,
+        # what `mts build` writes (coarse chunks first).
+        "torus_v5.mts": ["build", "--generated", "torus:300", "--prefixes", "none", "-o"],
         "ico_optimal_v5.mts": ["build", "--generated", "icosphere:80", "--optimal", "--level", "3", "-o"],
-        "torus_props_v5.mts": ["build", "--generated", "torus:300", "--properties", "-o"],
+        "torus_props_v5.mts": ["build", "--generated", "torus:300", "--properties", "--prefixes", "none", "-o"],
+        "torus_v6.mts": ["build", "--generated", "torus:1k", "--prefixes", "5,20", "-o"],
+        "torus_props_v6.mts": ["build", "--generated", "torus:1k", "--properties", "-o"],
         # The hier family's: version-4 hierarchies.
         "terrain_h.mts": ["build", "--generated", "terrain:2k", "--hierarchy", "-o"],
         "torus_props_h.mts": ["build", "--generated", "torus:1k", "--properties", "--hierarchy", "-o"],

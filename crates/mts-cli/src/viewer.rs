@@ -22,7 +22,7 @@ use crate::gltf_scene::GltfScene;
 use crate::stdout::warnln;
 use glam::Vec3;
 use mts::hierarchy::{Hierarchy, ViewDependent};
-use mts::model::Extractor;
+use mts::model::{Extractor, Prefix};
 use mts::{Error, MtsModel, Result};
 use mts_render::camera::Camera;
 use mts_render::gpu::AdapterReport;
@@ -135,7 +135,68 @@ pub fn run_hierarchy(
     run_app(Shown::Hierarchy { h, checker }, title, max_frames)
 }
 
+/// A file arriving: each prefix that opens more LoDs than the one shown,
+/// then the whole model, as they arrive ([`run_streamed`]).
+pub struct Arrivals {
+    /// The prefixes, in order, opened on another thread.
+    pub receiver: std::sync::mpsc::Receiver<Result<Prefix>>,
+    /// The whole model's triangles at LoD 0 (shares are of these).
+    pub full_triangles: usize,
+    /// The file's bytes.
+    pub file_bytes: u64,
+}
+
+/// What a streamed view shows now and receives next.
+struct Stream {
+    arrivals: Arrivals,
+    checker: bool,
+    first_lod: usize,
+    bytes_used: usize,
+    whole: bool,
+}
+
+/// [`run`] on a model as its file arrives: `first` (a prefix of the
+/// file, [`MtsModel::from_prefix`]) is shown, then each prefix
+/// `arrivals` delivers replaces it (new buffers, the same camera), until
+/// the whole model. The manual share is of the whole model's triangles.
+/// The models shown are kept until the process ends (the viewer's window
+/// holds them by reference; a few coarse models and the whole one).
+///
+/// # Errors
+/// As [`run`], and a prefix that fails to open.
+pub fn run_streamed(
+    first: Prefix,
+    arrivals: Arrivals,
+    checker: bool,
+    title: &str,
+    max_frames: Option<u64>,
+) -> Result<ViewerReport> {
+    let stream = Stream {
+        arrivals,
+        checker,
+        first_lod: first.first_lod,
+        bytes_used: first.bytes_used,
+        whole: first.is_whole(),
+    };
+    let model: &'static MtsModel = Box::leak(Box::new(first.model));
+    let shown = Shown::Model {
+        model,
+        others: &[],
+        content: ViewerContent::Model { checker },
+    };
+    run_app_streamed(shown, title, max_frames, Some(stream))
+}
+
 fn run_app(shown: Shown<'_>, title: &str, max_frames: Option<u64>) -> Result<ViewerReport> {
+    run_app_streamed(shown, title, max_frames, None)
+}
+
+fn run_app_streamed(
+    shown: Shown<'_>,
+    title: &str,
+    max_frames: Option<u64>,
+    stream: Option<Stream>,
+) -> Result<ViewerReport> {
     let event_loop = EventLoop::new().map_err(|e| Error::Gpu(format!("no event loop: {e}")))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
@@ -144,6 +205,7 @@ fn run_app(shown: Shown<'_>, title: &str, max_frames: Option<u64>) -> Result<Vie
         max_frames,
         state: None,
         error: None,
+        stream,
     };
     event_loop
         .run_app(&mut app)
@@ -188,6 +250,8 @@ struct App<'m> {
     max_frames: Option<u64>,
     state: Option<State<'m>>,
     error: Option<Error>,
+    /// A streamed model's arrivals, until the window opens.
+    stream: Option<Stream>,
 }
 
 /// Everything that exists once the window does.
@@ -219,6 +283,9 @@ struct State<'m> {
     started: Instant,
     /// What the title shows (kept here: not every platform reads it back).
     status: String,
+    renderer_config: RendererConfig,
+    /// A model shown as its file arrives.
+    stream: Option<Stream>,
 }
 
 // One value per window, never moved around: the size difference is moot.
@@ -293,7 +360,10 @@ impl ApplicationHandler for App<'_> {
             return;
         }
         match State::new(event_loop, self.shown, &self.title) {
-            Ok(state) => self.state = Some(state),
+            Ok(mut state) => {
+                state.stream = self.stream.take();
+                self.state = Some(state);
+            }
             Err(e) => {
                 self.error = Some(e);
                 event_loop.exit();
@@ -545,6 +615,8 @@ impl<'m> State<'m> {
             total_frames: 0,
             started: Instant::now(),
             status: String::new(),
+            renderer_config,
+            stream: None,
         })
     }
 
@@ -590,7 +662,38 @@ impl<'m> State<'m> {
         (stats.triangles, stats.indices_drawn)
     }
 
+    /// Shows the next prefix of a streamed file when one has arrived.
+    fn take_arrival(&mut self) -> Result<()> {
+        let Some(stream) = &mut self.stream else {
+            return Ok(());
+        };
+        let Ok(arrived) = stream.arrivals.receiver.try_recv() else {
+            return Ok(());
+        };
+        let prefix = arrived?;
+        stream.first_lod = prefix.first_lod;
+        stream.bytes_used = prefix.bytes_used;
+        stream.whole = prefix.is_whole();
+        let model: &'static MtsModel = Box::leak(Box::new(prefix.model));
+        let appearance = mts_render::texture::Appearance {
+            checker: stream.checker,
+        };
+        let renderer = StripRenderer::for_model_with(
+            &self.device,
+            &self.queue,
+            &self.renderer_config,
+            model,
+            &appearance,
+        )?;
+        self.drawn = Drawn::Model {
+            renderer,
+            extractor: Extractor::new(model),
+        };
+        Ok(())
+    }
+
     fn frame(&mut self) -> Result<()> {
+        self.take_arrival()?;
         let (w, h) = (self.config.width, self.config.height);
         let aspect = w as f32 / h as f32;
         let camera = match (&self.drawn, self.flying) {
@@ -637,6 +740,9 @@ impl<'m> State<'m> {
                         camera.projection(h as f32).pixels_per_unit(nearest),
                         DEFAULT_PIXEL_ERROR,
                     )
+                } else if let Some(stream) = &self.stream {
+                    let full = stream.arrivals.full_triangles as f64;
+                    model.lod_for_triangles((self.ratio * full).round() as usize)
                 } else {
                     model.lod_for_ratio(self.ratio)
                 };
@@ -716,9 +822,17 @@ impl<'m> State<'m> {
                 _ if self.auto => (" (auto)".to_owned(), "extraction"),
                 _ => (String::new(), "extraction"),
             };
+            let arrived = match &self.stream {
+                Some(s) if s.whole => format!(", whole file of {} bytes", s.arrivals.file_bytes),
+                Some(s) => format!(
+                    ", first {} of {} bytes: LoDs {}..",
+                    s.bytes_used, s.arrivals.file_bytes, s.first_lod
+                ),
+                None => String::new(),
+            };
             self.status = format!(
                 "mts view: {triangles} triangles{note}, {indices} indices sent, {work} {:.0} us, \
-                 {fps:.0} fps ({}, {:?})",
+                 {fps:.0} fps ({}, {:?}){arrived}",
                 self.extract_us, self.report.name, self.report.backend
             );
             self.window.set_title(&self.status);

@@ -110,9 +110,9 @@ fn build_writes_the_coded_file_by_default() {
         ));
         levels.push(info["levels"].clone());
     }
-    assert_eq!(sizes[0].0, 5);
+    assert_eq!(sizes[0].0, 6);
     assert_eq!(sizes[1].0, 3);
-    assert_eq!(sizes[2].0, 5);
+    assert_eq!(sizes[2].0, 6);
     assert!(sizes[0].1 * 2 < sizes[1].1, "{sizes:?}");
     assert!(sizes[0].1 <= sizes[2].1, "level 17 against 1: {sizes:?}");
     assert_eq!(levels[0], levels[1]);
@@ -130,6 +130,86 @@ fn build_writes_the_coded_file_by_default() {
         let (ok, _, err) = mts(&args);
         assert!(!ok && err.contains("--level"), "{bad:?}: {err}");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `build` writes chunks at 1% and 10% (`prefixes` in its JSON and
+/// `info`'s); `extract --bytes N` opens the finest chunk the first N bytes
+/// hold (`lods_available`), draws the same triangle count as the whole
+/// file at a LoD they hold, and refuses fewer bytes than the first chunk;
+/// `verify` checks the chunks; `--prefixes none` writes none.
+#[test]
+fn a_prefix_of_the_built_file_opens_its_coarse_lods() {
+    let dir = std::env::temp_dir().join(format!("mts-cli-prefix-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("t.mts").to_str().unwrap().to_string();
+    let (ok, text, err) = mts(&["build", "--generated", "torus:20k", "-o", &out, "--json"]);
+    assert!(ok, "{err}");
+    let b = json(&text);
+    let chunks = b["prefixes"].as_array().unwrap().clone();
+    assert_eq!(chunks.len(), 2, "{chunks:?}");
+    let full = b["triangles"].as_u64().unwrap();
+    let tenth = &chunks[1];
+    assert!(tenth["triangles"].as_u64().unwrap() <= full / 10);
+    let end = tenth["bytes"].as_u64().unwrap();
+    assert!(end * 100 <= b["bytes"].as_u64().unwrap() * 15, "{tenth}");
+    let (ok, info, _) = mts(&["info", &out, "--json"]);
+    assert!(ok);
+    assert_eq!(json(&info)["prefixes"], b["prefixes"]);
+    let extract = |n: u64, ratio: &str| {
+        let n = n.to_string();
+        mts(&[
+            "extract", &out, "--bytes", &n, "--ratio", ratio, "--json", "--repeat", "1",
+        ])
+    };
+    let (ok, text, err) = extract(end, "0.1");
+    assert!(ok && !err.contains("not in the first"), "{err}");
+    let p = json(&text);
+    let first = tenth["first_lod"].as_u64().unwrap();
+    assert_eq!(p["lods_available"][0].as_u64().unwrap(), first);
+    assert_eq!(p["lods_available"][1], b["max_lod"]);
+    assert_eq!(p["whole"], false);
+    assert_eq!(p["bytes_used"].as_u64().unwrap(), end);
+    let lod = p["lod"].as_u64().unwrap().to_string();
+    let (ok, whole, _) = mts(&["extract", &out, "--lod", &lod, "--json", "--repeat", "1"]);
+    assert!(ok);
+    assert_eq!(json(&whole)["triangles"], p["triangles"]);
+    // A finer LoD than the prefix holds draws its first, and says so.
+    let (ok, text, err) = extract(end, "1");
+    assert!(ok && err.contains("not in the first"), "{err}");
+    assert_eq!(json(&text)["lod"].as_u64().unwrap(), first);
+    // The whole file, and fewer bytes than the first chunk.
+    let (ok, text, _) = extract(u64::MAX, "1");
+    assert!(ok && json(&text)["whole"] == true);
+    let (ok, _, err) = extract(100, "0.1");
+    assert!(
+        !ok && err.contains("t.mts") && err.contains("no whole chunk"),
+        "{err}"
+    );
+    let (ok, text, err) = mts(&["verify", &out, "--json"]);
+    assert!(ok, "{err}");
+    assert_eq!(json(&text)["prefixes_checked"], 2);
+    let (ok, text, _) = mts(&[
+        "build",
+        "--generated",
+        "torus:2k",
+        "-o",
+        &out,
+        "--json",
+        "--prefixes",
+        "none",
+    ]);
+    assert!(ok && json(&text)["prefixes"].as_array().unwrap().is_empty());
+    let (ok, _, err) = mts(&[
+        "build",
+        "--generated",
+        "torus:2k",
+        "-o",
+        &out,
+        "--prefixes",
+        "0",
+    ]);
+    assert!(!ok && err.contains("--prefixes"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -282,10 +282,10 @@ fn each_loader_names_a_file_of_the_other_kind() {
         assert!(text.contains("per-object model"), "{text}");
     }
     let mut other = bytes.clone();
-    other[8] = 6;
+    other[8] = 7;
     assert_eq!(holds(&other), None);
-    let text = assert_parse_error(load(&other), "version 6");
-    assert!(text.contains("version 6"), "{text}");
+    let text = assert_parse_error(load(&other), "version 7");
+    assert!(text.contains("version 7"), "{text}");
     assert_eq!(holds(b"MTSMODEL"), None);
 }
 

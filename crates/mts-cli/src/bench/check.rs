@@ -247,9 +247,11 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
                 && b.raw_u16 > 0
                 && b.mts_file > 0
                 && b.mts_file < b.mts_file_uncompressed
+                && b.prefix_bytes_10 <= b.prefix_bytes_50
+                && b.prefix_bytes_50 <= b.mts_file
                 && b.mts_recipe_file > 0
                 && b.mts_memory > 0,
-            at("bytes: a size is 0"),
+            at("bytes: a size is 0, or the coded file is not below the uncoded one, or a prefix is past the file"),
         );
         for seq in ["linear", "exponential", "random"] {
             match m.extraction.get(seq) {

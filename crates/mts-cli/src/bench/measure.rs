@@ -624,8 +624,14 @@ fn measure_model(
 ) -> Result<(Model, MtsModel)> {
     let (model, _, t) = build_from_mesh(mesh, &PipelineOptions::default(), &mut |_, _| {});
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-    let coded = model.to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL);
+    let coded = model.to_streamed_bytes(
+        mts::model::compress::DEFAULT_LEVEL,
+        &mts::model::DEFAULT_PREFIX_SHARES,
+    );
     let file_bytes = coded.len();
+    let chunks = mts::model::chunk_index(&coded, std::path::Path::new("bench.mts"))?;
+    let prefix_bytes =
+        |share: f64| mts::model::bytes_for_lod(&chunks, file_bytes, model.lod_for_ratio(share));
     let stats = model.stats();
     // Struct fields are evaluated as written: the sections run in this
     // order.
@@ -640,6 +646,8 @@ fn measure_model(
             raw: model.raw_bytes() as u64,
             raw_u16: model.raw_bytes_u16() as u64,
             mts_file: file_bytes as u64,
+            prefix_bytes_10: prefix_bytes(0.1) as u64,
+            prefix_bytes_50: prefix_bytes(0.5) as u64,
             mts_file_uncompressed: model.to_bytes().len() as u64,
             mts_recipe_file: model.to_recipe_bytes().len() as u64,
             mts_memory: stats.memory_bytes as u64,
@@ -810,7 +818,10 @@ fn measure_scale(progress: &dyn Fn(&str)) -> Result<Scale> {
         let (model_bytes, rss) = (model.stats().memory_bytes, peak_rss());
         drop(ex);
         let file = model.to_bytes();
-        let coded = model.to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL);
+        let coded = model.to_streamed_bytes(
+            mts::model::compress::DEFAULT_LEVEL,
+            &mts::model::DEFAULT_PREFIX_SHARES,
+        );
         drop(model);
         let load = |bytes: &[u8]| {
             time_us(3, || {

@@ -414,17 +414,17 @@ pub fn report(results: &Results) -> String {
         results.command, results.elapsed_s,
     );
     let _ = writeln!(s, "## Table 1: models and sizes (bytes)\n");
-    let _ = writeln!(s, "The `.mts` file holds the model ready to walk, coded (version 5, what `mts build` writes; uncoded, version 3, beside it); the recipe-only file (`mts build --recipe-only`) loads by building the graphs again. Memory is the model's arrays with its vertices and their properties.\n");
-    let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | uncoded .mts / raw | recipe-only .mts / raw | MTS in memory | memory / raw | memory bytes / triangle | build ms (stripify ‖ simplify, model, total) |");
+    let _ = writeln!(s, "The `.mts` file holds coarse chunks at 1% and 10% of the triangles, then the model ready to walk, coded (version 6, what `mts build` writes; uncoded, version 3, beside it); prefix 10% / 50% is the share of that file a reader needs before it can draw 10% / 50% of the triangles (`mts extract --bytes N`); the recipe-only file (`mts build --recipe-only`) loads by building the graphs again. Memory is the model's arrays with its vertices and their properties.\n");
+    let _ = writeln!(s, "| model | strips | triangles | vertices | LoDs | bands | raw (12/vertex + 12/triangle) | raw 16-bit (12 + 6) | .mts file | .mts / raw | prefix 10% / 50% | uncoded .mts / raw | recipe-only .mts / raw | MTS in memory | memory / raw | memory bytes / triangle | build ms (stripify ‖ simplify, model, total) |");
     let _ = writeln!(
         s,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in models {
         let (b, t) = (&r.bytes, &r.build_ms);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1}% / {:.0}% | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.0} ‖ {:.0}, {:.0}, {:.0} |",
             r.name,
             r.strips,
             r.triangles,
@@ -435,6 +435,8 @@ pub fn report(results: &Results) -> String {
             b.raw_u16,
             b.mts_file,
             b.mts_file as f64 / b.raw as f64,
+            100.0 * b.prefix_bytes_10 as f64 / b.mts_file.max(1) as f64,
+            100.0 * b.prefix_bytes_50 as f64 / b.mts_file.max(1) as f64,
             b.mts_file_uncompressed as f64 / b.raw as f64,
             b.mts_recipe_file as f64 / b.raw as f64,
             b.mts_memory,

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 9;
+pub const SCHEMA_VERSION: u32 = 10;
 
 /// Steps (of 255) an RGB byte may move before an image comparison
 /// (Figure 6's, the scene's, the properties') counts the pixel as changed.
@@ -166,9 +166,15 @@ pub struct Model {
 pub struct Bytes {
     pub raw: u64,
     pub raw_u16: u64,
-    /// The ready `.mts` file `mts build` writes (version 5, coded at
-    /// `mts::model::compress::DEFAULT_LEVEL`).
+    /// The ready `.mts` file `mts build` writes (version 6: coarse chunks
+    /// at `mts::model::DEFAULT_PREFIX_SHARES`, then version 5's sections
+    /// coded at `mts::model::compress::DEFAULT_LEVEL`).
     pub mts_file: u64,
+    /// The first bytes of that file that open and draw 10% of the
+    /// triangles (`mts::model::bytes_for_lod`).
+    pub prefix_bytes_10: u64,
+    /// ... and 50% (the whole file when no chunk holds that LoD).
+    pub prefix_bytes_50: u64,
     /// The ready file uncoded (version 3, `mts build --uncompressed`).
     pub mts_file_uncompressed: u64,
     /// The recipe-only `.mts` (`mts build --recipe-only`).
@@ -359,8 +365,8 @@ pub struct ScaleRow {
     /// validate, extractor ready; median ms).
     pub file_bytes: u64,
     pub load_ms: f64,
-    /// The coded file (version 5, `mts build`'s default level) and loading
-    /// it (decode too).
+    /// The coded file `mts build` writes (version 6) and loading it
+    /// (decode too).
     pub coded_file_bytes: u64,
     pub coded_load_ms: f64,
     pub extract_lod0_us: f64,

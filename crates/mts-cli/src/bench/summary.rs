@@ -232,6 +232,19 @@ fn targets(s: &mut String, results: &Results, models: &[Model]) {
             ),
             ratio <= 1.5,
         );
+        let prefix = b.bytes.prefix_bytes_10 as f64 / b.bytes.mts_file.max(1) as f64;
+        row(
+            s,
+            "bunny: share of the .mts file that opens and draws 10% of the triangles",
+            "≤ 15%",
+            format!(
+                "{:.1}% ({} bytes; 50%: {:.0}%)",
+                100.0 * prefix,
+                b.bytes.prefix_bytes_10,
+                100.0 * b.bytes.prefix_bytes_50 as f64 / b.bytes.mts_file.max(1) as f64
+            ),
+            prefix <= 0.15,
+        );
         let memory = b.bytes.mts_memory as f64 / b.bytes.raw as f64;
         row(
             s,

@@ -44,7 +44,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub recipe_only: bool,
     /// Write the ready arrays uncoded (version 3): about three times the
-    /// bytes of the default coded file (version 5), loaded a few
+    /// bytes of the default coded file (version 6), loaded a few
     /// milliseconds sooner.
     #[arg(long, conflicts_with = "recipe_only")]
     pub uncompressed: bool,
@@ -55,6 +55,14 @@ pub struct BuildArgs {
     #[arg(long, value_parser = clap::value_parser!(i32).range(1..=22),
           conflicts_with_all = ["recipe_only", "uncompressed", "hierarchy"])]
     pub level: Option<i32>,
+    /// Where the coded file's coarse chunks are, in percent of the
+    /// triangles, comma-separated ("none" for no chunk): a prefix of the
+    /// file that holds one opens as the model of the LoDs from there on
+    /// (`mts extract --bytes N`). 1,10 by default (about 4% of the file);
+    /// each chunk costs about half a raw mesh per share.
+    #[arg(long, value_parser = prefix_shares,
+          conflicts_with_all = ["recipe_only", "uncompressed", "hierarchy"])]
+    pub prefixes: Option<Shares>,
     /// Build the view-dependent hierarchy instead (mts::hierarchy: a DAG
     /// of cluster groups, each a multiresolution strip model over its
     /// locked-border sequence) and write it as a version-4 .mts file, which
@@ -123,11 +131,17 @@ pub fn run(args: &BuildArgs) -> Result<()> {
     } else if args.uncompressed {
         model.to_bytes()
     } else {
-        model.to_compressed_bytes(args.level.unwrap_or(mts::model::compress::DEFAULT_LEVEL))
+        let shares = args
+            .prefixes
+            .as_ref()
+            .map_or(mts::model::DEFAULT_PREFIX_SHARES.to_vec(), |s| s.0.clone());
+        let level = args.level.unwrap_or(mts::model::compress::DEFAULT_LEVEL);
+        model.to_streamed_bytes(level, &shares)
     };
     let coding = coding.elapsed();
     mts::output::write_file(&args.output, &bytes)?;
     let version = mts::model::format::file_version(&bytes).unwrap_or(0);
+    let chunks = mts::model::chunk_index(&bytes, &args.output)?;
     let st = model.stats();
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     if args.json {
@@ -141,6 +155,7 @@ pub fn run(args: &BuildArgs) -> Result<()> {
                 "strips": st.strips,
                 "bytes": bytes.len(),
                 "file_version": version,
+                "prefixes": chunk_json(&chunks, &model, bytes.len()),
                 "ms_write": ms(coding),
                 "recipe_bytes": recipe.len(),
                 "raw_bytes": model.raw_bytes(),
@@ -186,6 +201,16 @@ pub fn run(args: &BuildArgs) -> Result<()> {
             ms(coding),
             args.output.display()
         )?;
+        for c in &chunks {
+            outln!(
+                "            its first {} bytes ({:.1}%) open LoDs {}.. ({} triangles, {:.1}%)",
+                c.end,
+                100.0 * c.end as f64 / bytes.len() as f64,
+                c.first_lod,
+                model.triangle_count(c.first_lod),
+                100.0 * model.triangle_count(c.first_lod) as f64 / mesh.triangle_count() as f64
+            )?;
+        }
         if !args.recipe_only {
             outln!(
                 "            of which the recipe {} bytes = {:.2} x raw (what --recipe-only writes)",
@@ -355,4 +380,51 @@ fn note_gltf_parts(source: &MeshSource) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Chunk shares in percent (`--prefixes`), as fractions.
+#[derive(Clone, Debug)]
+pub struct Shares(pub Vec<f64>);
+
+fn prefix_shares(s: &str) -> std::result::Result<Shares, String> {
+    if s == "none" {
+        return Ok(Shares(Vec::new()));
+    }
+    let shares = s
+        .split(',')
+        .map(|p| match p.trim().parse::<f64>() {
+            Ok(x) if x > 0.0 && x < 100.0 => Ok(x / 100.0),
+            _ => Err(format!(
+                "{p:?} is not a share in percent between 0 and 100 (exclusive)"
+            )),
+        })
+        .collect::<std::result::Result<Vec<f64>, String>>()?;
+    if shares.len() > mts::model::prefix::MAX_PREFIXES {
+        return Err(format!(
+            "{} chunks, at most {}",
+            shares.len(),
+            mts::model::prefix::MAX_PREFIXES
+        ));
+    }
+    Ok(Shares(shares))
+}
+
+/// The chunks of a version-6 file as `build --json` and `info --json`
+/// give them: each one's first LoD, its triangles, where it ends.
+pub(crate) fn chunk_json(
+    chunks: &[mts::model::Chunk],
+    model: &mts::MtsModel,
+    file_len: usize,
+) -> serde_json::Value {
+    chunks
+        .iter()
+        .map(|c| {
+            json!({
+                "first_lod": c.first_lod,
+                "triangles": model.triangle_count(c.first_lod),
+                "bytes": c.end,
+                "share_of_file": c.end as f64 / file_len.max(1) as f64,
+            })
+        })
+        .collect()
 }

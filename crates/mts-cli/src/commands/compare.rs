@@ -30,7 +30,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let (model, _, _) = build_with_bar(&mesh, &Default::default())?;
     let mts_ms = t.elapsed().as_secs_f64() * 1e3;
     let raw = raw_bytes_u16(&mesh);
-    let coded = model.to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL);
+    let coded = model.to_streamed_bytes(
+        mts::model::compress::DEFAULT_LEVEL,
+        &mts::model::DEFAULT_PREFIX_SHARES,
+    );
     let rows = measure_methods(&model, &mesh, mts_ms, args.requests, &coded)?;
     let mesh_info = json!({
         "input": name,

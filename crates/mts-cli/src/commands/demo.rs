@@ -53,7 +53,10 @@ pub fn demo(name: &str, mesh: &mts::Mesh, thumbnails: &std::path::Path) -> Resul
         model.base_strips().run_count(),
     )?;
     let file_bytes = model
-        .to_compressed_bytes(mts::model::compress::DEFAULT_LEVEL)
+        .to_streamed_bytes(
+            mts::model::compress::DEFAULT_LEVEL,
+            &mts::model::DEFAULT_PREFIX_SHARES,
+        )
         .len();
     outln!(
         ".mts file {file_bytes} bytes = {:.2} x the raw mesh (12 bytes per vertex + 12 per triangle), as `mts build` writes it",

@@ -2,7 +2,7 @@
 
 use crate::args::*;
 use crate::stdout::outln;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use mts::mesh::Mesh;
 use mts::methods::Method;
@@ -30,6 +30,12 @@ pub struct ExtractArgs {
     /// --triangles or --ratio to compare methods.
     #[arg(long, value_parser = method_parser(), default_value = "mts")]
     pub method: Method,
+    /// Read only the first N bytes of the .mts file, as a reader would
+    /// while it arrives: a version-6 file (what `mts build` writes) opens
+    /// from its first coarse chunk, as the model of the LoDs it holds
+    /// (`lods_available`); a LoD finer than those draws the finest held.
+    #[arg(long, conflicts_with = "method")]
+    pub bytes: Option<u64>,
 }
 
 pub fn run(args: &ExtractArgs) -> Result<()> {
@@ -39,6 +45,9 @@ pub fn run(args: &ExtractArgs) -> Result<()> {
     }
     if args.method != Method::Mts {
         return extract_baseline(args);
+    }
+    if let Some(n) = args.bytes {
+        return extract_prefix(args, n);
     }
     let started = Instant::now();
     let (name, model) = args.source.model()?;
@@ -89,6 +98,7 @@ pub fn run(args: &ExtractArgs) -> Result<()> {
             "indices_per_triangle": ex.indices_sent() as f64 / triangles.max(1) as f64,
             "us": us,
             "load_ms": load_ms,
+            "lods_available": [0, model.max_lod()],
         });
         if let Some(n) = vertices_written {
             v["vertices_written"] = json!(n);
@@ -101,6 +111,117 @@ pub fn run(args: &ExtractArgs) -> Result<()> {
             ex.indices_sent(),
             ex.indices_sent() as f64 / triangles.max(1) as f64,
             times.len()
+        )?;
+    }
+    Ok(())
+}
+
+/// `extract --bytes N`: the LoD from the first `n` bytes of an `.mts`
+/// file.
+fn extract_prefix(args: &ExtractArgs, n: u64) -> Result<()> {
+    use mts::Extractor;
+    let Some(path) = &args.source.mesh else {
+        bail!("--bytes reads the first bytes of an .mts file: give one");
+    };
+    let mut bytes = mts::mesh::io::read_file(path)?;
+    if !bytes.starts_with(mts::model::format::MAGIC) {
+        bail!(
+            "{}: --bytes reads the first bytes of an .mts file, not a mesh",
+            path.display()
+        );
+    }
+    let file_bytes = bytes.len();
+    bytes.truncate(usize::try_from(n).unwrap_or(usize::MAX));
+    let started = Instant::now();
+    let prefix = mts::MtsModel::from_prefix(&bytes, path)?;
+    let ready = Extractor::new(&prefix.model);
+    let load_ms = started.elapsed().as_secs_f64() * 1e3;
+    drop(ready);
+    let available = prefix.lods_available();
+    let asked = args
+        .level
+        .resolve_in(*available.end(), prefix.full_triangles, |t| {
+            prefix.lod_for_triangles(t)
+        })?
+        .context("give --lod, --triangles or --ratio")?;
+    let lod = asked.clamp(*available.start(), *available.end());
+    // A budget the prefix's first LoD is under asks for a finer LoD than
+    // it holds (unless it is the whole file).
+    let budget = match (args.level.lod, args.level.triangles, args.level.ratio) {
+        (Some(_), _, _) => None,
+        (_, Some(n), _) => Some(n as f64),
+        (_, _, r) => r.map(|r| r * prefix.full_triangles as f64),
+    };
+    let coarser = lod != asked || budget.is_some_and(|b| !prefix.holds_budget(b.round() as usize));
+    if coarser {
+        eprintln!(
+            "note: the LoD asked for is not in the first {} bytes, which hold LoDs {}..={}: drawing LoD {lod}",
+            bytes.len(),
+            available.start(),
+            available.end()
+        );
+    }
+    let model = &prefix.model;
+    let mut times = Vec::with_capacity(args.repeat.max(1));
+    let mut ex = Extractor::new(model);
+    for _ in 0..args.repeat.max(1) {
+        ex = Extractor::new(model);
+        let t = Instant::now();
+        ex.set_lod(prefix.model_lod(lod));
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    times.sort_by(f64::total_cmp);
+    let us = times[times.len() / 2];
+    let triangles = model.triangle_count(prefix.model_lod(lod));
+    let mut compact = Vec::new();
+    ex.write_compact(&mut compact);
+    let runs = compact
+        .split(|&i| i == mts::strip::encode::RESTART_U32)
+        .filter(|r| !r.is_empty())
+        .count();
+    let mut vertices_written = None;
+    if let Some(out) = &args.output {
+        let mesh = Mesh::level(model.positions(), &ex.triangles(), model.properties());
+        super::save_mesh(&mesh, out)?;
+        vertices_written = Some(mesh.vertex_count());
+    }
+    let name = path.display().to_string();
+    if args.json {
+        let mut v = json!({
+                "input": name,
+                "bytes": bytes.len(),
+                "file_bytes": file_bytes,
+                "bytes_used": prefix.bytes_used,
+                "whole": prefix.is_whole(),
+                "lods_available": [available.start(), available.end()],
+                "lod": lod,
+                "max_lod": available.end(),
+                "triangles": triangles,
+                "strips": runs,
+                "full_triangles": prefix.full_triangles,
+                "indices": ex.indices_sent(),
+                "indices_per_triangle": ex.indices_sent() as f64 / triangles.max(1) as f64,
+                "us": us,
+                "load_ms": load_ms,
+        });
+        if let Some(n) = vertices_written {
+            v["vertices_written"] = json!(n);
+        }
+        outln!("{v}")?;
+    } else {
+        outln!(
+            "{name}: the first {} of {file_bytes} bytes ({:.1}%) open LoDs {}..={} ({}), opened in {load_ms:.1} ms; LoD {lod}: {triangles} triangles of {}, {} indices sent, extracted in {us:.1} us",
+            bytes.len(),
+            100.0 * bytes.len() as f64 / file_bytes.max(1) as f64,
+            available.start(),
+            available.end(),
+            if prefix.is_whole() {
+                "the whole model"
+            } else {
+                "a coarse chunk, built"
+            },
+            prefix.full_triangles,
+            ex.indices_sent(),
         )?;
     }
     Ok(())

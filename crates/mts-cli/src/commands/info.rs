@@ -28,8 +28,9 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     }
     let model = MtsModel::from_bytes(&bytes, &args.model)?;
     let version = mts::model::format::file_version(&bytes).unwrap_or(0);
-    drop(bytes);
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let chunks = mts::model::chunk_index(&bytes, &args.model)?;
+    drop(bytes);
     let file_bytes = std::fs::metadata(&args.model)
         .with_context(|| format!("cannot read {}", args.model.display()))?
         .len();
@@ -76,6 +77,9 @@ pub fn run(args: &InfoArgs) -> Result<()> {
             "memory_bytes": st.memory_bytes,
             "levels": levels,
         });
+        if version == mts::model::STREAMED_VERSION {
+            v["prefixes"] = super::build::chunk_json(&chunks, &model, usize::try_from(file_bytes)?);
+        }
         // Only for a model with properties, so that the output of the
         // others stays as it was.
         if !props.is_empty() {
@@ -101,6 +105,15 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         )?;
         outln!("  {} vertices, {} triangles, {} LoDs, {} bands, {} strips, {} nodes, {} arcs, {:.1} MB in memory",
             model.positions().len(), model.triangle_count(0), model.max_lod() + 1, model.band_count(), st.strips, st.nodes, st.arcs, st.memory_bytes as f64 / 1e6)?;
+        for c in &chunks {
+            outln!(
+                "  its first {} bytes ({:.1}%) open LoDs {}.. ({} triangles)",
+                c.end,
+                100.0 * c.end as f64 / file_bytes.max(1) as f64,
+                c.first_lod,
+                model.triangle_count(c.first_lod)
+            )?;
+        }
         if !props.is_empty() {
             outln!(
                 "  properties: {} on {points} points; texture: {}",

@@ -34,6 +34,19 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
     let lods = spread(model.max_lod(), requested);
     let t = Instant::now();
     let report = mts::model::verify(&model, &model.mesh(), &lods);
+    // A version-6 file's chunks, each against the whole model at the LoDs
+    // it holds.
+    let mut chunk_problem = None;
+    let mut chunks_checked = 0;
+    if let Some(path) = &args.source.mesh {
+        let bytes = mts::mesh::io::read_file(path)?;
+        for chunk in mts::MtsModel::prefixes_of(&bytes, path)? {
+            chunks_checked += 1;
+            if let Err(e) = chunk.check_against(&model, &lods) {
+                chunk_problem.get_or_insert(e);
+            }
+        }
+    }
     let secs = t.elapsed().as_secs_f64();
     if args.json {
         outln!(
@@ -43,6 +56,7 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
                 "lods_checked": report.lods_checked,
                 "mismatches": report.mismatches,
                 "first_mismatch": report.first_mismatch.as_ref().map(|(l, what)| json!({"lod": l, "what": what})),
+                "prefixes_checked": chunks_checked,
                 "seconds": secs,
             })
         )?;
@@ -54,6 +68,15 @@ pub fn run(args: &VerifyArgs) -> Result<()> {
         if let Some((lod, what)) = &report.first_mismatch {
             outln!("  first at LoD {lod}: {what}")?;
         }
+    }
+    if chunks_checked > 0 && !args.json {
+        outln!(
+            "  {chunks_checked} coarse chunks checked against the model: {}",
+            chunk_problem.as_deref().unwrap_or("the same triangles")
+        )?;
+    }
+    if let Some(problem) = chunk_problem {
+        bail!("{name}: a coarse chunk does not draw the model's triangles: {problem}");
     }
     if let Some((lod, what)) = &report.first_mismatch {
         bail!(

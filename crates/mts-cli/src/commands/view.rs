@@ -46,11 +46,91 @@ pub struct ViewArgs {
     /// model built with them).
     #[arg(long)]
     checker: bool,
+    /// Show an .mts model as if its file arrived at this many bytes a
+    /// second (e.g. 500000): the coarsest chunk of a version-6 file
+    /// (what `mts build` writes) first, refined as each later chunk and
+    /// then the whole file arrive (`mts extract --bytes N` opens the same
+    /// prefixes).
+    #[arg(long, value_name = "BYTES_PER_S", value_parser = arrive_rate,
+          conflicts_with_all = ["scene", "hierarchy"])]
+    arrive: Option<f64>,
+}
+
+fn arrive_rate(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(r) if r.is_finite() && r >= 1.0 => Ok(r),
+        _ => Err(format!("{s:?} is not a rate of at least 1 byte a second")),
+    }
+}
+
+/// `view --arrive`: the model's file opened prefix by prefix, each
+/// arriving after its bytes at `rate` bytes a second.
+fn run_streamed(args: &ViewArgs, rate: f64) -> Result<()> {
+    use crate::viewer::{run_streamed, Arrivals};
+    let Some(path) = args.source.mesh.clone() else {
+        anyhow::bail!("--arrive shows an .mts file as it arrives: give one");
+    };
+    let bytes = mts::mesh::io::read_file(&path)?;
+    if !bytes.starts_with(mts::model::format::MAGIC) {
+        anyhow::bail!(
+            "{}: --arrive shows an .mts file (`mts build` writes one), not a mesh",
+            path.display()
+        );
+    }
+    let chunks = mts::model::chunk_index(&bytes, &path)?;
+    let ends: Vec<usize> = chunks
+        .iter()
+        .map(|c| c.end)
+        .chain(std::iter::once(bytes.len()))
+        .collect();
+    // The first chunk shows once its bytes have arrived.
+    std::thread::sleep(std::time::Duration::from_secs_f64(ends[0] as f64 / rate));
+    let first = MtsModel::from_prefix(&bytes[..ends[0]], &path)?;
+    let full_triangles = first.full_triangles;
+    let (send, receiver) = std::sync::mpsc::channel();
+    let started = std::time::Instant::now();
+    let file = path.clone();
+    let file_bytes = bytes.len() as u64;
+    std::thread::spawn(move || {
+        for &end in &ends[1..] {
+            let due = std::time::Duration::from_secs_f64(end as f64 / rate);
+            std::thread::sleep(due.saturating_sub(started.elapsed()));
+            if send
+                .send(MtsModel::from_prefix(&bytes[..end], &file))
+                .is_err()
+            {
+                return;
+            }
+        }
+    });
+    let name = path.display().to_string();
+    let report = run_streamed(
+        first,
+        Arrivals {
+            receiver,
+            full_triangles,
+            file_bytes,
+        },
+        args.checker,
+        &format!("mts view: {name} (arriving)"),
+        args.frames,
+    )?;
+    outln!(
+        "{name}: {} frames in {:.1} s on {}; last: {}",
+        report.frames,
+        report.seconds,
+        report.adapter,
+        report.last_status
+    )?;
+    Ok(())
 }
 
 /// `mts view`: opens the viewer window.
 pub fn run(args: &ViewArgs) -> Result<()> {
     use crate::viewer::{run, run_gltf, run_hierarchy, ViewerContent};
+    if let Some(rate) = args.arrive {
+        return run_streamed(args, rate);
+    }
     if let Some((name, h)) = super::render::load_hierarchy(&args.source, args.hierarchy)? {
         if args.scene.is_some() {
             anyhow::bail!(

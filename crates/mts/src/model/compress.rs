@@ -277,6 +277,23 @@ pub(crate) fn pack(recipe: &[Vec<u8>], modl: &[Vec<u8>; MODL_PARTS], level: i32)
     out
 }
 
+/// A section of one part holding `data`: coded with Zstandard at `level`,
+/// or stored when that does not shrink it or would decode to more than
+/// [`MAX_EXPANSION`] × its bytes (a version-6 chunk, `model/prefix.rs`).
+pub(crate) fn pack_one(data: &[u8], level: i32) -> Vec<u8> {
+    let frame = zstd::bulk::compress(data, level)
+        .ok()
+        .filter(|f| f.len() < data.len() && data.len() as u64 <= MAX_EXPANSION * f.len() as u64);
+    let mut out = Vec::with_capacity(frame.as_ref().map_or(data.len(), Vec::len) + 24);
+    put_varint(&mut out, 1);
+    out.push(if frame.is_some() { ZSTD } else { STORED });
+    put_varint(&mut out, data.len() as u64);
+    let bytes = frame.as_deref().unwrap_or(data);
+    put_varint(&mut out, bytes.len() as u64);
+    out.extend_from_slice(bytes);
+    out
+}
+
 /// Checks, before anything is decoded, that the parts of a version-5
 /// file's coded `sections` ask loading to hold at most `MAX_EXPANSION` ×
 /// `file_len` bytes in all: each part's announced length times

@@ -58,12 +58,16 @@
 //! [`MtsModel::from_bytes`] says so when given one, and [`holds`] tells
 //! the two kinds apart from the header.
 //!
-//! Version 5 ([`COMPRESSED_VERSION`], what `mts build` writes) is version 3
+//! Version 5 ([`COMPRESSED_VERSION`], `mts build --prefixes none`) is version 3
 //! with each section's payload coded with Zstandard, `MODL` in six
 //! parts ([`super::compress`]): about a third of version 3's bytes (the
 //! bunny: 2.1 MB against 7.2 MB, 1.71 × the raw mesh), decoded, then
 //! checked as version 3 (the `MODL` head's counts against the decoded
 //! parts' lengths instead of the section's). Its checksum is version 3's.
+//!
+//! Version 6 ([`super::prefix::STREAMED_VERSION`], what `mts build`
+//! writes) is version 5 with `PRFX` chunks first, the recipes of coarse
+//! LoDs, so that a prefix of the file opens ([`super::prefix`]).
 
 use super::records::Narrow;
 use super::{build, BuildOptions, MtsModel};
@@ -78,13 +82,13 @@ use std::path::{Path, PathBuf};
 pub const MAGIC: &[u8; 8] = b"MTSMODEL";
 /// The version of the ready file with its arrays as they lie in memory
 /// ([`MtsModel::to_bytes`]); this crate reads 1, 2 and
-/// [`COMPRESSED_VERSION`] too.
+/// [`COMPRESSED_VERSION`] and [`super::prefix::STREAMED_VERSION`] too.
 pub const VERSION: u32 = 3;
 /// The version of a model file whose sections are coded
 /// ([`MtsModel::to_compressed_bytes`], [`super::compress`]).
 pub const COMPRESSED_VERSION: u32 = 5;
-const HEADER_LEN: usize = 32;
-const TAGS: [&[u8; 4]; 7] = [
+pub(crate) const HEADER_LEN: usize = 32;
+pub(crate) const TAGS: [&[u8; 4]; 7] = [
     b"META", b"POSI", b"STRP", b"STEP", b"PROP", b"CMPN", b"MODL",
 ];
 /// Sections of a version-1 file.
@@ -95,7 +99,7 @@ const V1_SECTIONS: usize = 4;
 const VERTEX_TAGS: [&[u8; 4]; 2] = [b"POSI", b"PROP"];
 
 /// Sections of a file of `version`.
-fn section_count(version: u32) -> usize {
+pub(crate) fn section_count(version: u32) -> usize {
     match version {
         1 => V1_SECTIONS,
         2 => 6,
@@ -135,7 +139,7 @@ pub fn file_version(bytes: &[u8]) -> Option<u32> {
 #[must_use]
 pub fn holds(bytes: &[u8]) -> Option<Holds> {
     match file_version(bytes)? {
-        1..=VERSION | COMPRESSED_VERSION => Some(Holds::Model),
+        1..=VERSION | COMPRESSED_VERSION | super::prefix::STREAMED_VERSION => Some(Holds::Model),
         crate::hierarchy::format::VERSION => Some(Holds::Hierarchy),
         _ => None,
     }
@@ -200,12 +204,18 @@ impl MtsModel {
     /// reads it.
     #[must_use]
     pub fn to_compressed_bytes(&self, level: i32) -> Vec<u8> {
+        let mut body = Vec::new();
+        let sections = self.coded_sections(level);
+        let count = sections.len();
+        put_sections(&mut body, sections);
+        seal_body(COMPRESSED_VERSION, count, &body)
+    }
+
+    /// The sections of a version-5 file, coded at `level`.
+    pub(crate) fn coded_sections(&self, level: i32) -> Vec<(&'static [u8; 4], Vec<u8>)> {
         let recipe = self.payloads(2);
         let payloads = super::compress::pack(&recipe, &self.model_parts(true), level);
-        let mut body = Vec::new();
-        let sections = payloads.len();
-        put_sections(&mut body, TAGS.iter().copied().zip(payloads));
-        seal_body(COMPRESSED_VERSION, sections, &body)
+        TAGS.iter().copied().zip(payloads).collect()
     }
 
     fn encode(&self, ready: bool) -> Vec<u8> {
@@ -401,7 +411,10 @@ impl MtsModel {
     /// naming the byte offset and section of the first problem otherwise
     /// (truncation, checksum, counts, indices, labels).
     pub fn from_bytes(bytes: &[u8], file: &Path) -> Result<MtsModel> {
-        if file_version(bytes) == Some(COMPRESSED_VERSION) {
+        if matches!(
+            file_version(bytes),
+            Some(COMPRESSED_VERSION | super::prefix::STREAMED_VERSION)
+        ) {
             return read_coded_model(bytes, file);
         }
         let sections = model_sections(bytes, file)?;
@@ -415,7 +428,11 @@ impl MtsModel {
 /// are decoded and parsed; then as version 3.
 fn read_coded_model(bytes: &[u8], file: &Path) -> Result<MtsModel> {
     use super::compress::{check_expansion, only_part, unpack_recipe};
-    let (_, mut top) = check_header(bytes, file, Holds::Model, section_count)?;
+    let (version, mut top) = check_header(bytes, file, Holds::Model, section_count)?;
+    if version == super::prefix::STREAMED_VERSION {
+        // The chunks come first; the whole model does not need them.
+        skip_prefixes(&mut top, bytes)?;
+    }
     let mut coded = split_sections(&mut top, &TAGS)?;
     top.finish()?;
     check_expansion(&coded, bytes.len())?;
@@ -451,6 +468,22 @@ fn read_coded_model(bytes: &[u8], file: &Path) -> Result<MtsModel> {
         }));
         read_model(sections, file, true)
     })
+    .and_then(|model| {
+        if version == super::prefix::STREAMED_VERSION {
+            super::prefix::check_chunks(bytes, file, &model)?;
+        }
+        Ok(model)
+    })
+}
+
+/// Steps `top` over a version-6 file's chunks (`PRFX` sections: the
+/// header's section count less version 5's), each checked against the
+/// bytes left; `mts verify` opens them ([`MtsModel::prefixes_of`]).
+fn skip_prefixes(top: &mut Reader<'_>, bytes: &[u8]) -> Result<()> {
+    let declared = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
+    let tags = vec![super::prefix::PREFIX_TAG; declared.saturating_sub(TAGS.len())];
+    split_sections(top, &tags)?;
+    Ok(())
 }
 
 /// Decodes one model's sections and checks it: a recipe (no `MODL`) is
@@ -517,7 +550,7 @@ struct Parsed<'a> {
     options: BuildOptions,
 }
 
-fn parse_error(file: &Path, byte: usize, element: &str, message: String) -> Error {
+pub(crate) fn parse_error(file: &Path, byte: usize, element: &str, message: String) -> Error {
     Error::Parse {
         file: file.to_owned(),
         place: Place {
@@ -701,21 +734,25 @@ pub(crate) fn check_header<'a>(
     let version = u32_at(8);
     let hierarchy = crate::hierarchy::format::VERSION;
     let wrong = match (holds, version) {
-        (Holds::Model, 1..=VERSION | COMPRESSED_VERSION) => None,
+        (Holds::Model, 1..=VERSION | COMPRESSED_VERSION | super::prefix::STREAMED_VERSION) => None,
         (Holds::Hierarchy, v) if v == hierarchy => None,
         (Holds::Model, v) if v == hierarchy => Some(format!(
             "byte 8: .mts version {v} holds a view-dependent hierarchy (`mts build \
              --hierarchy`), not a per-object model: `mts info` and `mts verify` read it (in \
              the library: mts::hierarchy::Hierarchy::load)"
         )),
-        (Holds::Hierarchy, v @ (1..=VERSION | COMPRESSED_VERSION)) => Some(format!(
+        (
+            Holds::Hierarchy,
+            v @ (1..=VERSION | COMPRESSED_VERSION | super::prefix::STREAMED_VERSION),
+        ) => Some(format!(
             "byte 8: .mts version {v} holds a per-object model, not a view-dependent \
              hierarchy (version {hierarchy}): `mts build --hierarchy` writes one (in the \
              library: mts::MtsModel::load reads this file)"
         )),
         (_, v) => Some(format!(
-            "byte 8: .mts version {v}; this build reads versions 1 to {VERSION} and \
-             {COMPRESSED_VERSION} (a model) and {hierarchy} (a hierarchy)"
+            "byte 8: .mts version {v}; this build reads versions 1 to {VERSION}, \
+             {COMPRESSED_VERSION} and {} (a model) and {hierarchy} (a hierarchy)",
+            super::prefix::STREAMED_VERSION
         )),
     };
     if let Some(message) = wrong {
@@ -726,12 +763,21 @@ pub(crate) fn check_header<'a>(
     }
     let header = |byte, m: String| parse_error(file, byte, "header", m);
     let section_count = sections(version);
-    if u32_at(12) as usize != section_count {
+    let streamed = holds == Holds::Model && version == super::prefix::STREAMED_VERSION;
+    let extra = (u32_at(12) as usize).saturating_sub(section_count);
+    if u32_at(12) as usize != section_count
+        && !(streamed && (1..=super::prefix::MAX_PREFIXES).contains(&extra))
+    {
         return Err(header(
             12,
             format!(
-                "{} sections, expected {section_count} in version {version}",
-                u32_at(12)
+                "{} sections, expected {section_count}{} in version {version}",
+                u32_at(12),
+                if streamed {
+                    format!(" to {}", section_count + super::prefix::MAX_PREFIXES)
+                } else {
+                    String::new()
+                }
             ),
         ));
     }

@@ -33,6 +33,7 @@ mod digest;
 mod extract;
 pub mod format;
 mod pipeline;
+pub mod prefix;
 pub(crate) mod records;
 pub mod requests;
 mod segments;
@@ -44,6 +45,9 @@ pub use build::{
 };
 pub use extract::{Extractor, Update};
 pub use pipeline::{build_from_mesh, try_build_from_mesh, PipelineOptions, PipelineTimings};
+pub use prefix::{
+    bytes_for_lod, chunk_index, Chunk, Prefix, DEFAULT_PREFIX_SHARES, STREAMED_VERSION,
+};
 pub use verify::{spread_lods, verify, VerifyReport};
 
 use glam::Vec3;
