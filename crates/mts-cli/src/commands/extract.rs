@@ -60,33 +60,13 @@ pub fn run(args: &ExtractArgs) -> Result<()> {
         .level
         .resolve_model(&model)?
         .context("give --lod, --triangles or --ratio")?;
-    // Each timed extraction starts from an empty extractor (no coherence).
-    let mut times = Vec::with_capacity(args.repeat.max(1));
-    let mut ex = Extractor::new(&model);
-    for _ in 0..args.repeat.max(1) {
-        ex = Extractor::new(&model);
-        let t = Instant::now();
-        ex.set_lod(lod);
-        times.push(t.elapsed().as_secs_f64() * 1e6);
-    }
-    times.sort_by(f64::total_cmp);
-    let us = times[times.len() / 2];
-    let mut compact = Vec::new();
-    ex.write_compact(&mut compact);
-    let runs = compact
-        .split(|&i| i == mts::strip::encode::RESTART_U32)
-        .filter(|r| !r.is_empty())
-        .count();
+    let Extracted {
+        ex,
+        us,
+        runs,
+        vertices_written,
+    } = extract_timed(&model, lod, args)?;
     let triangles = model.triangle_count(lod);
-    let mut vertices_written = None;
-    if let Some(out) = &args.output {
-        // The level's own vertices only, renumbered; their properties are
-        // the input vertices' (a model with properties has no created
-        // vertices: endpoint placement).
-        let mesh = Mesh::level(model.positions(), &ex.triangles(), model.properties());
-        super::save_mesh(&mesh, out)?;
-        vertices_written = Some(mesh.vertex_count());
-    }
     if args.json {
         let mut v = json!({
             "input": name,
@@ -110,10 +90,60 @@ pub fn run(args: &ExtractArgs) -> Result<()> {
             model.max_lod(),
             ex.indices_sent(),
             ex.indices_sent() as f64 / triangles.max(1) as f64,
-            times.len()
+            args.repeat.max(1)
         )?;
     }
     Ok(())
+}
+
+/// One LoD extracted: the extractor, the median microseconds, the strips
+/// (runs) it sends, the vertices `-o` wrote.
+struct Extracted<'m> {
+    ex: mts::Extractor<'m>,
+    us: f64,
+    runs: usize,
+    vertices_written: Option<usize>,
+}
+
+/// Extracts `lod` of `model` `--repeat` times, each from an empty
+/// extractor (no coherence), and writes it to `-o` when given.
+fn extract_timed<'m>(
+    model: &'m mts::MtsModel,
+    lod: usize,
+    args: &ExtractArgs,
+) -> Result<Extracted<'m>> {
+    use mts::Extractor;
+    let mut times = Vec::with_capacity(args.repeat.max(1));
+    let mut ex = Extractor::new(model);
+    for _ in 0..args.repeat.max(1) {
+        ex = Extractor::new(model);
+        let t = Instant::now();
+        ex.set_lod(lod);
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+    }
+    times.sort_by(f64::total_cmp);
+    let us = times[times.len() / 2];
+    let mut compact = Vec::new();
+    ex.write_compact(&mut compact);
+    let runs = compact
+        .split(|&i| i == mts::strip::encode::RESTART_U32)
+        .filter(|r| !r.is_empty())
+        .count();
+    let mut vertices_written = None;
+    if let Some(out) = &args.output {
+        // The level's own vertices only, renumbered; their properties are
+        // the input vertices' (a model with properties has no created
+        // vertices: endpoint placement).
+        let mesh = Mesh::level(model.positions(), &ex.triangles(), model.properties());
+        super::save_mesh(&mesh, out)?;
+        vertices_written = Some(mesh.vertex_count());
+    }
+    Ok(Extracted {
+        ex,
+        us,
+        runs,
+        vertices_written,
+    })
 }
 
 /// `extract --bytes N`: the LoD from the first `n` bytes of an `.mts`
@@ -162,29 +192,13 @@ fn extract_prefix(args: &ExtractArgs, n: u64) -> Result<()> {
         );
     }
     let model = &prefix.model;
-    let mut times = Vec::with_capacity(args.repeat.max(1));
-    let mut ex = Extractor::new(model);
-    for _ in 0..args.repeat.max(1) {
-        ex = Extractor::new(model);
-        let t = Instant::now();
-        ex.set_lod(prefix.model_lod(lod));
-        times.push(t.elapsed().as_secs_f64() * 1e6);
-    }
-    times.sort_by(f64::total_cmp);
-    let us = times[times.len() / 2];
+    let Extracted {
+        ex,
+        us,
+        runs,
+        vertices_written,
+    } = extract_timed(model, prefix.model_lod(lod), args)?;
     let triangles = model.triangle_count(prefix.model_lod(lod));
-    let mut compact = Vec::new();
-    ex.write_compact(&mut compact);
-    let runs = compact
-        .split(|&i| i == mts::strip::encode::RESTART_U32)
-        .filter(|r| !r.is_empty())
-        .count();
-    let mut vertices_written = None;
-    if let Some(out) = &args.output {
-        let mesh = Mesh::level(model.positions(), &ex.triangles(), model.properties());
-        super::save_mesh(&mesh, out)?;
-        vertices_written = Some(mesh.vertex_count());
-    }
     let name = path.display().to_string();
     if args.json {
         let mut v = json!({

@@ -115,14 +115,7 @@ fn run_streamed(args: &ViewArgs, rate: f64) -> Result<()> {
         &format!("mts view: {name} (arriving)"),
         args.frames,
     )?;
-    outln!(
-        "{name}: {} frames in {:.1} s on {}; last: {}",
-        report.frames,
-        report.seconds,
-        report.adapter,
-        report.last_status
-    )?;
-    Ok(())
+    closing_line(&name, &report)
 }
 
 /// `mts view`: opens the viewer window.
@@ -184,6 +177,11 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         &format!("mts view: {name}"),
         args.frames,
     )?;
+    closing_line(&name, &report)
+}
+
+/// The line `view` prints when its window closes.
+fn closing_line(name: &str, report: &crate::viewer::ViewerReport) -> Result<()> {
     outln!(
         "{name}: {} frames in {:.1} s on {}; last: {}",
         report.frames,
