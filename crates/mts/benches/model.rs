@@ -2,7 +2,9 @@
 //! icosphere when `../shared/models` is absent): the graphs from strips and
 //! the contraction sequence (one band, and banded), and the whole pipeline
 //! from the mesh; loading the model's `.mts` bytes (parse, validate,
-//! extractor ready). Extraction is in `benches/extract.rs`.
+//! extractor ready): uncoded (version 3), coded with its chunks (version
+//! 6, what `mts build` writes), and opening that file's first chunks only
+//! (the 1% and 10% prefixes, built). Extraction is in `benches/extract.rs`.
 
 mod common;
 
@@ -52,6 +54,26 @@ fn bench(c: &mut Criterion) {
             black_box(mts::Extractor::new(&m).buffer().len())
         });
     });
+    let streamed = model.to_streamed_bytes(
+        mts::model::compress::DEFAULT_LEVEL,
+        &mts::model::DEFAULT_PREFIX_SHARES,
+    );
+    group.bench_function("load_streamed_whole", |b| {
+        b.iter(|| {
+            let m = mts::MtsModel::from_bytes(black_box(&streamed), file).expect("loads");
+            black_box(mts::Extractor::new(&m).buffer().len())
+        });
+    });
+    let chunks = mts::model::chunk_index(&streamed, file).expect("its chunks");
+    for (chunk, share) in chunks.iter().zip(["1", "10"]) {
+        let prefix = &streamed[..chunk.end];
+        group.bench_function(format!("open_prefix_{share}_percent"), |b| {
+            b.iter(|| {
+                let p = mts::MtsModel::from_prefix(black_box(prefix), file).expect("opens");
+                black_box(mts::Extractor::new(&p.model).buffer().len())
+            });
+        });
+    }
     group.bench_function("validate", |b| {
         b.iter(|| black_box(&model).validate());
     });
