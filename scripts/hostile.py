@@ -3726,8 +3726,14 @@ class V5File:
         self.sections = []
         # Version 6 (crates/mts/src/model/prefix.rs): version 5 with coarse
         # chunks first, PRFX sections of one part each.
-        tags = [b"PRFX"] * (count - len(self.TAGS)) + self.TAGS if self.version == 6 else self.TAGS
-        for tag, payload in split_mts_sections(data, self.version if self.version == 6 else 5, tags):
+        # Version 7: a hierarchy's six sections (crates/mts/src/hierarchy/format.rs), one part each.
+        if self.version == 6:
+            tags = [b"PRFX"] * (count - len(self.TAGS)) + self.TAGS
+        elif self.version == 7:
+            tags = V4File.TAGS
+        else:
+            tags = self.TAGS
+        for tag, payload in split_mts_sections(data, self.version if self.version in (6, 7) else 5, tags):
             p = 0
             k, p = get_varint(payload, p)
             parts = []
@@ -3780,7 +3786,8 @@ def zstd_rle_frame(blocks, byte=0):
     return bytes(out)
 
 
-CODED_SEEDS = ("torus_v5.mts", "ico_optimal_v5.mts", "torus_props_v5.mts", "torus_v6.mts", "torus_props_v6.mts")
+CODED_SEEDS = ("torus_v5.mts", "ico_optimal_v5.mts", "torus_props_v5.mts", "torus_v6.mts", "torus_props_v6.mts",
+               "terrain_h7.mts")
 CODED_KINDS = ["truncate", "flip", "reseal_flip", "part_count", "decoded_len", "decoded_huge", "coding",
                "stored_lie", "frame_flip", "frame_cut", "parts_swapped", "bomb", "bomb_honest", "section_count",
                "trailing", "width", "width_claimed", "clean"]
@@ -3847,7 +3854,10 @@ def coded_edit(rng, f, kind):
         p[2] = bytes(data)
         return "%s.%d" % (f.sections[a][0].decode(), b)
     if kind == "parts_swapped":
-        modl = [ps for t, ps in f.sections if t == b"MODL"][0]
+        modls = [ps for t, ps in f.sections if t == b"MODL"]
+        if not modls:
+            return None
+        modl = modls[0]
         a, b = rng.sample(range(len(modl)), 2)
         modl[a], modl[b] = modl[b], modl[a]
         return "MODL.%d<->%d" % (a, b)
@@ -3861,7 +3871,7 @@ def coded_edit(rng, f, kind):
         part[2] = frame
         return "%s:%d" % (name, blocks)
     if kind == "section_count":
-        f.section_count = rng.choice([0, 6, 8, 2 ** 32 - 1])
+        f.section_count = rng.choice([c for c in (0, 6, 7, 8, 2 ** 32 - 1) if c != len(f.sections)])
         return str(f.section_count)
     if kind == "trailing":
         f.trailing = bytes(rng.randrange(256) for _ in range(rng.randint(1, 16)))
@@ -3875,8 +3885,11 @@ def gen_coded(rng, seeds, index, quick=False):
     case.run(["verify", "{in}", "--lods", "4"], expect)
 
     case.run(["info", "{in}", "--json"] if rng.random() < 0.3 else ["info", "{in}"], by_verify)
+    # A hierarchy (version 7) is not a model: extract refuses every one.
+    hierarchy = len(case.data) > MTS_HEADER and case.data[8] == 7
     case.run(rng.choice([["extract", "{in}", "--lod", "0", "--repeat", "1"],
-                         ["extract", "{in}", "--ratio", "0.5", "--repeat", "1", "--json"]]), by_verify)
+                         ["extract", "{in}", "--ratio", "0.5", "--repeat", "1", "--json"]]),
+             GARBAGE if hierarchy else by_verify)
     if len(case.data) > MTS_HEADER and case.data[8] == 6:
         # A prefix of a version-6 file, as a reader opens it while the file
         # arrives: a clean one opens from its first chunk's end on (and is
@@ -3936,8 +3949,11 @@ def make_seeds(mts_bin, root, timeout):
         "torus_v6.mts": ["build", "--generated", "torus:1k", "--prefixes", "5,20", "-o"],
         "torus_props_v6.mts": ["build", "--generated", "torus:1k", "--properties", "-o"],
         # The hier family's: version-4 hierarchies.
-        "terrain_h.mts": ["build", "--generated", "terrain:2k", "--hierarchy", "-o"],
-        "torus_props_h.mts": ["build", "--generated", "torus:1k", "--properties", "--hierarchy", "-o"],
+        "terrain_h.mts": ["build", "--generated", "terrain:2k", "--hierarchy", "--uncompressed", "-o"],
+        "torus_props_h.mts": ["build", "--generated", "torus:1k", "--properties", "--hierarchy", "--uncompressed",
+                              "-o"],
+        # The coded family's hierarchy: version 7, what `mts build --hierarchy` writes.
+        "terrain_h7.mts": ["build", "--generated", "terrain:2k", "--hierarchy", "-o"],
         "torus.stream": ["encode", "--generated", "torus:200", "-o"],
         "ico.stream": ["encode", "--generated", "icosphere:80", "-o"],
         "grid.stream": ["encode", "--generated", "grid:32", "-o"],

@@ -48,11 +48,37 @@ fn build_info_verify_a_terrain_hierarchy() {
     );
     assert!(b["memory_bytes"].as_u64().unwrap() > bytes / 2);
     assert!(b["build_ms"].as_f64().unwrap() > 0.0);
+    // Coded (version 7) by default; --uncompressed writes version 4, at
+    // more than twice the bytes.
+    assert_eq!(b["file_version"], 7);
+    let plain = dir.join("plain.mts");
+    let plain = plain.to_str().unwrap();
+    let (ok, out, err) = mts(&[
+        "build",
+        "--generated",
+        "terrain:20k",
+        "--hierarchy",
+        "--uncompressed",
+        "-o",
+        plain,
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let p = json(&out);
+    assert_eq!(p["file_version"], 4);
+    assert!(
+        p["bytes"].as_u64().unwrap() > 2 * bytes,
+        "{p} against {bytes}"
+    );
+    let (ok, out, err) = mts(&["info", plain, "--json"]);
+    assert!(ok, "{err}");
+    assert_eq!(json(&out)["groups"], b["groups"]);
 
     let (ok, out, err) = mts(&["info", file, "--json"]);
     assert!(ok, "{err}");
     let i = json(&out);
     assert_eq!(i["kind"], "hierarchy");
+    assert_eq!(i["file_version"], 7);
     for key in [
         "triangles",
         "vertices",

@@ -1,7 +1,8 @@
-//! The hierarchy's `.mts` file (version 4, `hierarchy/format.rs`): round
-//! trips equal, every truncation and flipped byte is an error or (resealed)
-//! a checked hierarchy, never a panic, a huge count allocates nothing, and
-//! each loader names a file of the other kind.
+//! The hierarchy's `.mts` file (version 4, `hierarchy/format.rs`, and its
+//! coded version 7): round trips equal, every truncation and flipped byte
+//! is an error or (resealed) a checked hierarchy, never a panic, a huge
+//! count or an amplifying part allocates nothing, and each loader names a
+//! file of the other kind.
 
 use mts::hierarchy::{self, Hierarchy, HierarchyOptions};
 use mts::mesh::generate::Generated;
@@ -282,10 +283,10 @@ fn each_loader_names_a_file_of_the_other_kind() {
         assert!(text.contains("per-object model"), "{text}");
     }
     let mut other = bytes.clone();
-    other[8] = 7;
+    other[8] = 8;
     assert_eq!(holds(&other), None);
-    let text = assert_parse_error(load(&other), "version 7");
-    assert!(text.contains("version 7"), "{text}");
+    let text = assert_parse_error(load(&other), "version 8");
+    assert!(text.contains("version 8"), "{text}");
     assert_eq!(holds(b"MTSMODEL"), None);
 }
 
@@ -438,6 +439,22 @@ fn structural_lies_are_refused() {
         let file = with_group(&bytes, g, &set_varint(&record, first, c));
         assert_parse_error(load(&file), &format!("input cluster {c}"));
     }
+    // HIER's cluster triangle or strip index count above the clusters'
+    // totals (found by the hostile-input harness: it loaded).
+    let (_, hier, len) = sections(&bytes)[0];
+    let payload = &bytes[hier..hier + len];
+    for k in [3, 4] {
+        let mut at = 0;
+        for _ in 0..k {
+            varint(payload, &mut at);
+        }
+        let n = varint(payload, &mut at.clone());
+        let lie = set_varint(payload, at, n + 2);
+        let text = assert_parse_error(load(&with_section(&bytes, 0, &lie)), "HIER count");
+        // Two more strip indices are read from CSTR, which ends first.
+        let expected = if k == 3 { "the clusters hold" } else { "CSTR" };
+        assert!(text.contains(expected), "{text}");
+    }
     // The own-vertices flag set without the sections.
     let mut lie = record.clone();
     lie[flag] = 1;
@@ -478,4 +495,80 @@ fn structural_lies_are_refused() {
     lie[level..level + 4].copy_from_slice(&123.0f32.to_le_bytes());
     let text = assert_parse_error(load(&with_group(&bytes, g, &lie)), "floor");
     assert!(text.contains("floor"), "{text}");
+}
+
+/// The coded file (version 7): the same hierarchy back from a third or
+/// less of version 4's bytes; every truncation refused; a flipped byte in
+/// a frame refused or (resealed) a checked hierarchy; a part announcing
+/// more than 1,024 times the file refused before anything is decoded.
+#[test]
+fn the_coded_file_round_trips_smaller_and_refuses_corruption() {
+    let (h, plain) = small();
+    let coded = h.to_compressed_bytes(3);
+    assert_eq!(
+        mts::model::format::file_version(&coded),
+        Some(hierarchy::format::CODED_VERSION)
+    );
+    assert_eq!(holds(&coded), Some(Holds::Hierarchy));
+    assert_eq!(load(&coded).unwrap(), h);
+    assert!(
+        coded.len() * 2 < plain.len(),
+        "{} against {}",
+        coded.len(),
+        plain.len()
+    );
+    let text = MtsModel::from_bytes(&coded, Path::new(FILE))
+        .unwrap_err()
+        .to_string();
+    assert!(text.contains("hierarchy"), "{text}");
+    for n in (0..coded.len()).step_by((coded.len() / 400).max(1)) {
+        assert_parse_error(load(&coded[..n]), &format!("{n} bytes"));
+        let mut cut = coded[..n].to_vec();
+        seal(&mut cut);
+        assert_parse_error(load(&cut), &format!("{n} bytes, resealed"));
+    }
+    let (mut refused, mut accepted) = (0, 0);
+    for (tag, start, len) in sections(&coded) {
+        for k in 0..len.min(32) {
+            let mut flipped = coded.clone();
+            flipped[start + k * len / len.min(32)] ^= 0x41;
+            assert_parse_error(load(&flipped), "flipped, not resealed");
+            seal(&mut flipped);
+            match load(&flipped) {
+                Err(e) => {
+                    let text = e.to_string();
+                    assert!(
+                        text.contains(FILE),
+                        "{}: {text}",
+                        String::from_utf8_lossy(&tag)
+                    );
+                    refused += 1;
+                }
+                Ok(back) => {
+                    back.validate().unwrap();
+                    accepted += 1;
+                }
+            }
+        }
+    }
+    assert!(
+        refused > 2 * accepted,
+        "{refused} refused, {accepted} accepted"
+    );
+    // GRPS announcing a terabyte: refused by the bound, nothing allocated
+    // for it.
+    let (_, grps, len) = sections(&coded)[5];
+    let mut part = coded[grps..grps + len].to_vec();
+    assert_eq!(part[0], 1, "one part");
+    let mut at = 2;
+    varint(&part, &mut at);
+    let mut huge = part[..2].to_vec();
+    put_varint(&mut huge, 1 << 40);
+    huge.extend_from_slice(&part[at..]);
+    part = huge;
+    let bomb = with_section(&coded, 5, &part);
+    let before = LARGEST.load(Ordering::Relaxed);
+    let text = assert_parse_error(load(&bomb), "a terabyte announced");
+    assert!(text.contains("1024"), "{text}");
+    assert!(LARGEST.load(Ordering::Relaxed) <= before.max(ALLOCATION_LIMIT));
 }

@@ -43,9 +43,9 @@ pub struct BuildArgs {
     /// instead of a few).
     #[arg(long)]
     pub recipe_only: bool,
-    /// Write the ready arrays uncoded (version 3): about three times the
-    /// bytes of the default coded file (version 6), loaded a few
-    /// milliseconds sooner.
+    /// Write the ready arrays uncoded (version 3; a hierarchy's version
+    /// 4): about three times the bytes of the default coded file (version
+    /// 6; a hierarchy's 7), loaded a few milliseconds sooner.
     #[arg(long, conflicts_with = "recipe_only")]
     pub uncompressed: bool,
     /// The Zstandard level of the coded file (1 to 22): 17 by default
@@ -53,7 +53,7 @@ pub struct BuildArgs {
     /// faster and a fifth larger, 19 about twice as slowly and a few
     /// percent smaller.
     #[arg(long, value_parser = clap::value_parser!(i32).range(1..=22),
-          conflicts_with_all = ["recipe_only", "uncompressed", "hierarchy"])]
+          conflicts_with_all = ["recipe_only", "uncompressed"])]
     pub level: Option<i32>,
     /// Where the coded file's coarse chunks are, in percent of the
     /// triangles, comma-separated ("none" for no chunk): a prefix of the
@@ -222,8 +222,8 @@ pub fn run(args: &BuildArgs) -> Result<()> {
     Ok(())
 }
 
-/// `build --hierarchy`: the hierarchy of `mesh`, written as a version-4
-/// file, and its sizes.
+/// `build --hierarchy`: the hierarchy of `mesh`, written as a version-7
+/// file (coded; version 4 with `--uncompressed`), and its sizes.
 fn run_hierarchy(
     args: &BuildArgs,
     name: &str,
@@ -238,8 +238,13 @@ fn run_hierarchy(
     let started = std::time::Instant::now();
     let h = hierarchy_with_progress(mesh, &options)?;
     let build = started.elapsed();
-    let bytes = h.to_bytes();
+    let bytes = if args.uncompressed {
+        h.to_bytes()
+    } else {
+        h.to_compressed_bytes(args.level.unwrap_or(mts::model::compress::DEFAULT_LEVEL))
+    };
     mts::output::write_file(&args.output, &bytes)?;
+    let version = mts::model::format::file_version(&bytes).unwrap_or(0);
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let raw = h.raw_bytes();
     if args.json {
@@ -254,6 +259,7 @@ fn run_hierarchy(
                 "clusters": h.clusters().len(),
                 "memory_bytes": h.memory_bytes(),
                 "bytes": bytes.len(),
+                "file_version": version,
                 "raw_bytes": raw,
                 "ms_load": ms(load),
                 "build_ms": ms(build),
@@ -279,7 +285,7 @@ fn run_hierarchy(
             h.memory_bytes() as f64 / raw as f64
         )?;
         outln!(
-            "  file      {} bytes = {:.2} x raw ({raw} bytes: 12 per vertex and its properties, 12 per triangle) -> {}",
+            "  file      {} bytes = {:.2} x raw ({raw} bytes: 12 per vertex and its properties, 12 per triangle), version {version} -> {}",
             bytes.len(),
             bytes.len() as f64 / raw as f64,
             args.output.display()

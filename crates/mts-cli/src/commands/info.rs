@@ -212,6 +212,7 @@ fn hierarchy_info(args: &InfoArgs, bytes: &[u8], t0: Instant) -> Result<()> {
             "file": args.model.display().to_string(),
             "kind": "hierarchy",
             "file_bytes": file_bytes,
+            "file_version": mts::model::format::file_version(bytes).unwrap_or(0),
             "bytes": file_bytes,
             "raw_bytes": raw,
             "load_ms": load_ms,

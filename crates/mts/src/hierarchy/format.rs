@@ -67,6 +67,25 @@ use std::path::Path;
 /// [`crate::model::format::VERSION`]).
 pub const VERSION: u32 = 4;
 
+/// The version of a hierarchy's coded file (what `mts build --hierarchy`
+/// writes): version 4 with each section's payload one part coded with
+/// Zstandard ([`crate::model::compress`]: a part count, coding, decoded
+/// and coded lengths, bytes; stored where coding does not shrink it).
+/// Decoded, then read as version 4. The parts may announce at most 1,024 ×
+/// the file's bytes in all, checked before anything is decoded.
+pub const CODED_VERSION: u32 = 7;
+
+/// Names of the decoded sections of a version-7 file in errors (places in
+/// them are offsets in the decoded bytes).
+const DECODED_NAMES: [&str; 6] = [
+    "HIER, decoded",
+    "POSI, decoded",
+    "PROP, decoded",
+    "CLUS, decoded",
+    "CSTR, decoded",
+    "GRPS, decoded",
+];
+
 const TAGS: [&[u8; 4]; 6] = [b"HIER", b"POSI", b"PROP", b"CLUS", b"CSTR", b"GRPS"];
 /// A group model's sections without its vertices (flag 0), and with them.
 const MODEL_TAGS: [&[u8; 4]; 5] = [b"META", b"STRP", b"STEP", b"CMPN", b"MODL"];
@@ -82,6 +101,30 @@ impl Hierarchy {
     /// [`Hierarchy::save`] writes.
     #[must_use]
     pub fn to_bytes(&self) -> Vec<u8> {
+        let payloads = self.payloads();
+        let mut body = Vec::new();
+        put_sections(&mut body, TAGS.iter().copied().zip(payloads));
+        seal_body(VERSION, TAGS.len(), &body)
+    }
+
+    /// The hierarchy as coded `.mts` bytes (version [`CODED_VERSION`]),
+    /// each section coded with Zstandard at `level` (1 to 22) on every
+    /// core: what `mts build --hierarchy` writes.
+    #[must_use]
+    pub fn to_compressed_bytes(&self, level: i32) -> Vec<u8> {
+        let payloads = self.payloads();
+        let coded = crate::parallel::map_indexed(
+            payloads.len(),
+            || (),
+            |(), i| crate::model::compress::pack_one(&payloads[i], level),
+        );
+        let mut body = Vec::new();
+        put_sections(&mut body, TAGS.iter().copied().zip(coded));
+        seal_body(CODED_VERSION, TAGS.len(), &body)
+    }
+
+    /// The payloads of the sections, in the order of `TAGS`.
+    fn payloads(&self) -> [Vec<u8>; 6] {
         let mut hier = Vec::new();
         for n in [
             self.vertex_count,
@@ -128,14 +171,7 @@ impl Hierarchy {
             grps.extend_from_slice(&(payload.len() as u64).to_le_bytes());
             grps.extend_from_slice(&payload);
         }
-        let mut body = Vec::new();
-        put_sections(
-            &mut body,
-            TAGS.iter()
-                .copied()
-                .zip([hier, posi, prop, clus, cstr, grps]),
-        );
-        seal_body(VERSION, TAGS.len(), &body)
+        [hier, posi, prop, clus, cstr, grps]
     }
 
     /// One group's record in `GRPS` (without its length).
@@ -207,9 +243,54 @@ impl Hierarchy {
     /// the section (and group) of the first problem otherwise, or the
     /// broken invariant.
     pub fn from_bytes(bytes: &[u8], file: &Path) -> Result<Hierarchy> {
-        let (_, mut top) = check_header(bytes, file, Holds::Hierarchy, |_| TAGS.len())?;
+        let (version, mut top) = check_header(bytes, file, Holds::Hierarchy, |_| TAGS.len())?;
         let sections = split_sections(&mut top, &TAGS)?;
         top.finish()?;
+        if version != CODED_VERSION {
+            return Hierarchy::from_sections(sections, &top, file);
+        }
+        // Every part's header first, and what they announce bounded, then
+        // each section decoded (on all cores) and read as version 4.
+        let parts = sections
+            .iter()
+            .map(crate::model::compress::only_part)
+            .collect::<Result<Vec<_>>>()?;
+        let announced = parts
+            .iter()
+            .fold(0u64, |sum, (_, p)| sum.saturating_add(p.decoded_len()));
+        let budget = crate::model::compress::MAX_EXPANSION * bytes.len() as u64;
+        if announced > budget {
+            return Err(top.error(format!(
+                "the sections announce {announced} decoded bytes, more than 1024 × the \
+                 file's {}",
+                bytes.len()
+            )));
+        }
+        let decoded = crate::parallel::map_indexed(
+            parts.len(),
+            || (),
+            |(), i| {
+                let (r, part) = &parts[i];
+                part.decode(r)
+            },
+        )
+        .into_iter()
+        .collect::<Result<Vec<Vec<u8>>>>()?;
+        let readers = decoded
+            .iter()
+            .zip(DECODED_NAMES)
+            .map(|(d, name)| Reader::new(d, 0, name, file))
+            .collect();
+        Hierarchy::from_sections(readers, &top, file)
+    }
+
+    /// Reads the six sections of a version-4 file (or a version-7 file's,
+    /// decoded).
+    fn from_sections(
+        sections: Vec<Reader<'_>>,
+        top: &Reader<'_>,
+        file: &Path,
+    ) -> Result<Hierarchy> {
         let [mut hier, mut posi, mut prop, mut clus, mut cstr, mut grps]: [Reader; 6] = sections
             .try_into()
             .map_err(|_| top.error("section count"))?;
@@ -342,6 +423,20 @@ impl Hierarchy {
                 ));
             }
             tris.extend(drawn);
+        }
+        // The counts HIER gives are the clusters' totals (a larger one
+        // would be a lie that nothing else reads).
+        if tris.len() != cluster_triangles || strip_end != strip_indices {
+            return Err(parse_error(
+                file,
+                hier.base,
+                "HIER",
+                format!(
+                    "{cluster_triangles} cluster triangles and {strip_indices} strip indices, \
+                     the clusters hold {} and {strip_end}",
+                    tris.len()
+                ),
+            ));
         }
 
         // GRPS: cut into groups here, decoded on all cores.

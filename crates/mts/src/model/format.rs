@@ -140,7 +140,9 @@ pub fn file_version(bytes: &[u8]) -> Option<u32> {
 pub fn holds(bytes: &[u8]) -> Option<Holds> {
     match file_version(bytes)? {
         1..=VERSION | COMPRESSED_VERSION | super::prefix::STREAMED_VERSION => Some(Holds::Model),
-        crate::hierarchy::format::VERSION => Some(Holds::Hierarchy),
+        crate::hierarchy::format::VERSION | crate::hierarchy::format::CODED_VERSION => {
+            Some(Holds::Hierarchy)
+        }
         _ => None,
     }
 }
@@ -733,10 +735,11 @@ pub(crate) fn check_header<'a>(
     };
     let version = u32_at(8);
     let hierarchy = crate::hierarchy::format::VERSION;
+    let coded_hierarchy = crate::hierarchy::format::CODED_VERSION;
     let wrong = match (holds, version) {
         (Holds::Model, 1..=VERSION | COMPRESSED_VERSION | super::prefix::STREAMED_VERSION) => None,
-        (Holds::Hierarchy, v) if v == hierarchy => None,
-        (Holds::Model, v) if v == hierarchy => Some(format!(
+        (Holds::Hierarchy, v) if v == hierarchy || v == coded_hierarchy => None,
+        (Holds::Model, v) if v == hierarchy || v == coded_hierarchy => Some(format!(
             "byte 8: .mts version {v} holds a view-dependent hierarchy (`mts build \
              --hierarchy`), not a per-object model: `mts info` and `mts verify` read it (in \
              the library: mts::hierarchy::Hierarchy::load)"
@@ -746,12 +749,13 @@ pub(crate) fn check_header<'a>(
             v @ (1..=VERSION | COMPRESSED_VERSION | super::prefix::STREAMED_VERSION),
         ) => Some(format!(
             "byte 8: .mts version {v} holds a per-object model, not a view-dependent \
-             hierarchy (version {hierarchy}): `mts build --hierarchy` writes one (in the \
+             hierarchy (version {hierarchy} or {coded_hierarchy}): `mts build --hierarchy` writes one (in the \
              library: mts::MtsModel::load reads this file)"
         )),
         (_, v) => Some(format!(
             "byte 8: .mts version {v}; this build reads versions 1 to {VERSION}, \
-             {COMPRESSED_VERSION} and {} (a model) and {hierarchy} (a hierarchy)",
+             {COMPRESSED_VERSION} and {} (a model) and {hierarchy} and {coded_hierarchy} (a \
+             hierarchy)",
             super::prefix::STREAMED_VERSION
         )),
     };
