@@ -567,6 +567,18 @@ fn the_coded_file_round_trips_smaller_and_refuses_corruption() {
     huge.extend_from_slice(&part[at..]);
     part = huge;
     let bomb = with_section(&coded, 5, &part);
+    // A quarter of the bound, announced as steps by column (which decoding
+    // holds six times over): over the bound by the weights the model's
+    // file uses too.
+    let (_, grps, len) = sections(&coded)[5];
+    let frame = &coded[grps..grps + len];
+    let mut at = 2;
+    varint(frame, &mut at);
+    let mut steps = vec![1, 3];
+    put_varint(&mut steps, 1024 * coded.len() as u64 / 4 / 12 * 12);
+    steps.extend_from_slice(&frame[at..]);
+    let text = assert_parse_error(load(&with_section(&coded, 5, &steps)), "steps announced");
+    assert!(text.contains("more than 1024"), "{text}");
     let before = LARGEST.load(Ordering::Relaxed);
     let text = assert_parse_error(load(&bomb), "a terabyte announced");
     assert!(text.contains("1024"), "{text}");

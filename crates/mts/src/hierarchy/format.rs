@@ -251,21 +251,11 @@ impl Hierarchy {
         }
         // Every part's header first, and what they announce bounded, then
         // each section decoded (on all cores) and read as version 4.
+        crate::model::compress::check_expansion(&sections, false, bytes.len())?;
         let parts = sections
             .iter()
             .map(crate::model::compress::only_part)
             .collect::<Result<Vec<_>>>()?;
-        let announced = parts
-            .iter()
-            .fold(0u64, |sum, (_, p)| sum.saturating_add(p.decoded_len()));
-        let budget = crate::model::compress::MAX_EXPANSION * bytes.len() as u64;
-        if announced > budget {
-            return Err(top.error(format!(
-                "the sections announce {announced} decoded bytes, more than 1024 × the \
-                 file's {}",
-                bytes.len()
-            )));
-        }
         let decoded = crate::parallel::map_indexed(
             parts.len(),
             || (),

@@ -294,16 +294,34 @@ pub(crate) fn pack_one(data: &[u8], level: i32) -> Vec<u8> {
     out
 }
 
-/// Checks, before anything is decoded, that the parts of a version-5
-/// file's coded `sections` ask loading to hold at most `MAX_EXPANSION` ×
-/// `file_len` bytes in all: each part's announced length times
-/// [`holding`] (each part's header checked as it is read).
-pub(crate) fn check_expansion(sections: &[Reader<'_>], file_len: usize) -> Result<()> {
+/// Checks, before anything is decoded, that the parts of coded
+/// `sections` ask loading to hold at most `MAX_EXPANSION` × `file_len`
+/// bytes in all: each part's announced length times [`holding`] (each
+/// part's header checked as it is read). Each section is one part, but
+/// the last with `modl_last` (a version-5 file's `MODL`, six parts); a
+/// version-6 chunk and a version-7 hierarchy's sections are checked here
+/// too.
+pub(crate) fn check_expansion(
+    sections: &[Reader<'_>],
+    modl_last: bool,
+    file_len: usize,
+) -> Result<()> {
+    check_expansion_of(sections, modl_last, file_len, "the file's")
+}
+
+/// [`check_expansion`] of `len` bytes that `whose` names in the error
+/// ("the chunk's").
+pub(crate) fn check_expansion_of(
+    sections: &[Reader<'_>],
+    modl_last: bool,
+    file_len: usize,
+    whose: &str,
+) -> Result<()> {
     let budget = MAX_EXPANSION * file_len as u64 + 64;
     let mut total = 0u64;
     for (i, s) in sections.iter().enumerate() {
         let mut r = s.clone();
-        let expected = if i + 1 == sections.len() {
+        let expected = if modl_last && i + 1 == sections.len() {
             MODL_PARTS
         } else {
             1
@@ -319,7 +337,7 @@ pub(crate) fn check_expansion(sections: &[Reader<'_>], file_len: usize) -> Resul
                 r.pos = at;
                 return Err(r.error(format!(
                     "{}the parts so far would take {total} bytes to decode, more than \
-                     {MAX_EXPANSION} × the file's {file_len}",
+                     {MAX_EXPANSION} × {whose} {file_len}",
                     part_prefix(name, &r)
                 )));
             }

@@ -431,13 +431,16 @@ impl MtsModel {
 fn read_coded_model(bytes: &[u8], file: &Path) -> Result<MtsModel> {
     use super::compress::{check_expansion, only_part, unpack_recipe};
     let (version, mut top) = check_header(bytes, file, Holds::Model, section_count)?;
-    if version == super::prefix::STREAMED_VERSION {
-        // The chunks come first; the whole model does not need them.
-        skip_prefixes(&mut top, bytes)?;
-    }
+    // A version-6 file's chunks come first; the whole model does not need
+    // them, but checks them once it is loaded.
+    let chunks = if version == super::prefix::STREAMED_VERSION {
+        skip_prefixes(&mut top, bytes)?
+    } else {
+        Vec::new()
+    };
     let mut coded = split_sections(&mut top, &TAGS)?;
     top.finish()?;
-    check_expansion(&coded, bytes.len())?;
+    check_expansion(&coded, true, bytes.len())?;
     let Some(modl) = coded.pop() else {
         return Err(top.error("no MODL section"));
     };
@@ -471,21 +474,19 @@ fn read_coded_model(bytes: &[u8], file: &Path) -> Result<MtsModel> {
         read_model(sections, file, true)
     })
     .and_then(|model| {
-        if version == super::prefix::STREAMED_VERSION {
-            super::prefix::check_chunks(bytes, file, &model)?;
-        }
+        super::prefix::check_chunks(&chunks, file, &model)?;
         Ok(model)
     })
 }
 
 /// Steps `top` over a version-6 file's chunks (`PRFX` sections: the
 /// header's section count less version 5's), each checked against the
-/// bytes left; `mts verify` opens them ([`MtsModel::prefixes_of`]).
-fn skip_prefixes(top: &mut Reader<'_>, bytes: &[u8]) -> Result<()> {
+/// bytes left, and returns them; `mts verify` opens them
+/// ([`MtsModel::prefixes_of`]).
+fn skip_prefixes<'a>(top: &mut Reader<'a>, bytes: &[u8]) -> Result<Vec<Reader<'a>>> {
     let declared = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
     let tags = vec![super::prefix::PREFIX_TAG; declared.saturating_sub(TAGS.len())];
-    split_sections(top, &tags)?;
-    Ok(())
+    split_sections(top, &tags)
 }
 
 /// Decodes one model's sections and checks it: a recipe (no `MODL`) is

@@ -41,7 +41,7 @@
 //! A sequence with optimal placement (created vertices) gets no chunks:
 //! a chunk's vertices are input vertices.
 
-use super::compress::{only_part, pack_one, MAX_EXPANSION};
+use super::compress::{check_expansion_of, only_part, pack_one};
 use super::format::{
     file_version, parse_error, put_varint, Reader, COMPRESSED_VERSION, HEADER_LEN, MAGIC, VERSION,
 };
@@ -135,9 +135,13 @@ impl Prefix {
 }
 
 /// The recipe model of `model`'s LoDs `lod..=max_lod` and each of its
-/// vertices' number in `model`; `None` for a sequence with optimal
-/// placement (see the module docs).
-pub(crate) fn coarse_model(model: &MtsModel, lod: usize) -> Option<(MtsModel, Vec<u32>)> {
+/// vertices' number in `model` (`full` is `model.mesh()`); `None` for a
+/// sequence with optimal placement (see the module docs).
+pub(crate) fn coarse_model(
+    model: &MtsModel,
+    full: &Mesh,
+    lod: usize,
+) -> Option<(MtsModel, Vec<u32>)> {
     let c = model.collapses();
     if c.is_optimal_placement() || lod > c.max_lod() {
         return None;
@@ -152,9 +156,8 @@ pub(crate) fn coarse_model(model: &MtsModel, lod: usize) -> Option<(MtsModel, Ve
     for (i, &v) in alive.iter().enumerate() {
         new_id[v as usize] = i as u32;
     }
-    let full = model.mesh();
     let triangles = c
-        .triangles_at(&full, lod)
+        .triangles_at(full, lod)
         .into_iter()
         .map(|t| t.map(|v| new_id[v as usize]))
         .collect();
@@ -206,9 +209,14 @@ pub(crate) fn chunks(model: &MtsModel, shares: &[f64], level: i32) -> Vec<Vec<u8
     lods.sort_unstable_by(|a, b| b.cmp(a));
     lods.dedup();
     lods.truncate(MAX_PREFIXES);
+    if model.collapses().is_optimal_placement() {
+        return Vec::new();
+    }
+    // The whole mesh once: each chunk replays it to its LoD.
+    let full = model.mesh();
     let mut out = Vec::with_capacity(lods.len());
     for (i, lod) in lods.into_iter().enumerate() {
-        let Some((mut coarse, ids)) = coarse_model(model, lod) else {
+        let Some((mut coarse, ids)) = coarse_model(model, &full, lod) else {
             return Vec::new();
         };
         if i > 0 {
@@ -298,16 +306,20 @@ fn whole_chunks<'a>(bytes: &'a [u8], file: &Path) -> Result<Vec<ChunkAt<'a>>> {
 }
 
 /// Checks the chunks of a whole version-6 file that loaded as `model`,
-/// without building them: each decodes (within [`MAX_EXPANSION`] × its
+/// without building them: each decodes (within `MAX_EXPANSION` × its
 /// bytes) to its first LoD (at most `model`'s last), the model's triangle
 /// count, strictly increasing vertex numbers of `model`, and a recipe
 /// file whose header, length and checksum hold. So a corrupt chunk makes
 /// the file corrupt; whether a chunk draws the model's triangles is
 /// `mts verify`'s ([`Prefix::check_against`]). About a millisecond for
 /// the bunny's.
-pub(crate) fn check_chunks(bytes: &[u8], file: &Path, model: &MtsModel) -> Result<()> {
-    for (i, c) in whole_chunks(bytes, file)?.iter().enumerate() {
-        let data = decode_chunk(i, c, file)?;
+pub(crate) fn check_chunks(chunks: &[Reader<'_>], file: &Path, model: &MtsModel) -> Result<()> {
+    for (i, r) in chunks.iter().enumerate() {
+        let c = ChunkAt {
+            at: r.base,
+            payload: r.bytes,
+        };
+        let data = decode_chunk(i, &c, file)?;
         let mut d = Reader::new(&data, 0, DECODED_NAMES[i], file);
         let head = ChunkHead::read(&mut d)?;
         let lod = head.first_lod;
@@ -421,17 +433,16 @@ impl ChunkHead {
     }
 }
 
-/// A chunk's part decoded, within [`MAX_EXPANSION`] × its bytes.
+/// A chunk's part decoded, within `MAX_EXPANSION` × its bytes.
 fn decode_chunk(i: usize, chunk: &ChunkAt<'_>, file: &Path) -> Result<Vec<u8>> {
     let section = Reader::new(chunk.payload, chunk.at, CHUNK_NAMES[i], file);
+    check_expansion_of(
+        std::slice::from_ref(&section),
+        false,
+        chunk.payload.len(),
+        "the chunk's",
+    )?;
     let (r, part) = only_part(&section)?;
-    if part.decoded_len() > MAX_EXPANSION * chunk.payload.len() as u64 + 64 {
-        return Err(section.error(format!(
-            "decodes to {} bytes, more than {MAX_EXPANSION} × its {}",
-            part.decoded_len(),
-            chunk.payload.len()
-        )));
-    }
     part.decode(&r)
 }
 
