@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 /// Where a mesh comes from: a file or a built-in generator.
 #[derive(Args)]
 pub struct MeshSource {
-    /// OBJ or PLY file (or an .mts model, for the commands that read a
-    /// model).
+    /// OBJ, PLY, glTF (.gltf, .glb) file (or an .mts model, for the commands
+    /// that read a model).
     #[arg(conflicts_with = "generated")]
     pub(crate) mesh: Option<PathBuf>,
     /// Built-in mesh NAME:SIZE, SIZE in triangles (k/M suffixes):
@@ -142,6 +142,50 @@ impl MeshSource {
             let (mesh, report) = mts::mesh::clean(raw, clean, &g.to_string())?;
             Ok((format!("generated {g}"), mesh, report))
         }
+    }
+}
+
+/// How a command that writes glTF stores the vertex data.
+#[derive(Args, Clone, Copy, Default)]
+pub struct GltfOut {
+    /// Write glTF compressed as engines ship it: quantized attributes
+    /// (KHR_mesh_quantization) coded with meshoptimizer's codecs
+    /// (EXT_meshopt_compression), the level in vertex-cache order. About
+    /// gltfpack -cc's size; a .glb or .gltf output only.
+    #[arg(long)]
+    pub compress: bool,
+    /// Write glTF quantized (KHR_mesh_quantization: 14-bit positions,
+    /// 8-bit normals and colours, 16-bit texture coordinates) but not
+    /// compressed, the level in vertex-cache order.
+    #[arg(long, conflicts_with = "compress")]
+    pub quantize: bool,
+}
+
+impl GltfOut {
+    /// The encoding asked for.
+    pub fn encoding(&self) -> mts::mesh::io::Encoding {
+        use mts::mesh::io::Encoding;
+        match (self.compress, self.quantize) {
+            (true, _) => Encoding::Compressed,
+            (false, true) => Encoding::Quantized,
+            _ => Encoding::Plain,
+        }
+    }
+
+    /// Refuses a quantized or compressed encoding for an output that is
+    /// not glTF.
+    pub fn check(&self, output: &std::path::Path) -> Result<()> {
+        let gltf = output
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+        if self.encoding() != mts::mesh::io::Encoding::Plain && !gltf {
+            anyhow::bail!(
+                "{}: --compress and --quantize write glTF: name the output .glb or .gltf",
+                output.display()
+            );
+        }
+        Ok(())
     }
 }
 

@@ -402,7 +402,7 @@ fn vertex_cache_order_is_near_meshoptimizer_s() {
 #[cfg(feature = "gltf")]
 mod gltf_chain {
     use super::*;
-    use mts::mesh::io::{load_bytes, parse_gltf, save_gltf, save_lod_chain, ChainLevel};
+    use mts::mesh::io::{load_bytes, parse_gltf, save_gltf, save_lod_chain, ChainLevel, Encoding};
     use serde_json::{json, Value};
 
     /// The JSON and BIN chunks of a `.glb`.
@@ -454,7 +454,7 @@ mod gltf_chain {
         let (mesh, lods, levels) = textured_chain();
         assert_eq!(lods.len(), 5, "{lods:?}");
         let path = dir.join("chain.glb");
-        save_lod_chain(&levels, &Coverage::default(), &path).unwrap();
+        save_lod_chain(&levels, &Coverage::default(), &path, Encoding::Plain).unwrap();
         let bytes = std::fs::read(&path).unwrap();
         gltf::Gltf::from_slice(&bytes).expect("the gltf crate accepts the chain");
         let (json, bin) = chunks(&bytes);
@@ -526,7 +526,13 @@ mod gltf_chain {
         assert_eq!(whole.triangle_count(), mesh.triangle_count());
 
         // A .gltf holds the same chain, its buffer beside it.
-        save_lod_chain(&levels, &Coverage::default(), &dir.join("chain.gltf")).unwrap();
+        save_lod_chain(
+            &levels,
+            &Coverage::default(),
+            &dir.join("chain.gltf"),
+            Encoding::Plain,
+        )
+        .unwrap();
         let text: Value =
             serde_json::from_slice(&std::fs::read(dir.join("chain.gltf")).unwrap()).unwrap();
         assert_eq!(text["buffers"][0]["uri"], "chain.bin");
@@ -541,20 +547,27 @@ mod gltf_chain {
         let dir = common::scratch("export", "bad_chain");
         let (_, _, mut levels) = textured_chain();
         let path = dir.join("c.glb");
-        assert!(save_lod_chain(&[], &Coverage::default(), &path).is_err());
+        assert!(save_lod_chain(&[], &Coverage::default(), &path, Encoding::Plain).is_err());
         let flat = Coverage {
             pixel_threshold: 0.0,
             ..Coverage::default()
         };
-        assert!(save_lod_chain(&levels, &flat, &path).is_err());
-        assert!(save_lod_chain(&levels, &Coverage::default(), &dir.join("c.obj")).is_err());
+        assert!(save_lod_chain(&levels, &flat, &path, Encoding::Plain).is_err());
+        assert!(save_lod_chain(
+            &levels,
+            &Coverage::default(),
+            &dir.join("c.obj"),
+            Encoding::Plain
+        )
+        .is_err());
         levels.swap(1, 3);
-        let err = save_lod_chain(&levels, &Coverage::default(), &path).unwrap_err();
+        let err =
+            save_lod_chain(&levels, &Coverage::default(), &path, Encoding::Plain).unwrap_err();
         // Level 1 now has the error of level 3, more than level 2's.
         assert!(err.to_string().contains("level 2"), "{err}");
         assert!(!path.exists());
         // One level: plain glTF, no extension.
-        save_lod_chain(&levels[..1], &Coverage::default(), &path).unwrap();
+        save_lod_chain(&levels[..1], &Coverage::default(), &path, Encoding::Plain).unwrap();
         let (json, _) = chunks(&std::fs::read(&path).unwrap());
         assert!(json.get("extensionsUsed").is_none());
         assert!(json["nodes"][0].get("extensions").is_none());

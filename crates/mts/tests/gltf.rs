@@ -642,11 +642,8 @@ fn unsupported_and_malformed_structures_are_refused_at_their_object() {
         case(&|b| b["extensionsRequired"] = json!(["KHR_draco_mesh_compression"])),
         Place::element("extensionsRequired", 0)
     );
-    // A triangle list whose index count is not a multiple of 3.
-    assert_eq!(
-        case(&|b| b["accessors"][2]["count"] = json!(2)),
-        Place::element("mesh 0 primitive", 0)
-    );
+    // (A triangle list whose index count is not a multiple of 3 is read:
+    // `a_list_whose_count_is_not_a_multiple_of_3_draws_its_whole_triangles`.)
     // A buffer whose data is shorter than its byteLength.
     let mut body = base.clone();
     body["asset"] = json!({ "version": "2.0" });
@@ -1248,4 +1245,168 @@ fn accessors_without_buffer_view_are_zeros_within_the_limit() {
     let (place, message) = parse_failure(&gltf_text(&Bin::default(), body), "t.gltf");
     assert_eq!(place, Place::element("accessor", 1));
     assert!(message.starts_with("no bufferView"), "{message}");
+}
+
+// ---------------------------------------------------------------------
+// Valid files the typed model alone would refuse: each class of the
+// Khronos validator's suite that is valid glTF, read as the specification
+// allows.
+
+/// `count: 3.0`: JSON has one number type, and the validator reads an
+/// integral float where an integer is due.
+#[test]
+fn integers_written_as_floats_are_read() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["accessors"][0]["count"] = json!(3.0);
+    body["meshes"][0]["primitives"][0]["indices"] = json!(2.0);
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+}
+
+/// An animation channel whose target has no `node` (KHR_animation_pointer
+/// names it instead) and a scene without `nodes`: both optional in glTF
+/// 2.0, both required by the typed model; animations are not read.
+#[test]
+fn optional_fields_the_model_requires_are_not_required() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["nodes"] = json!([{ "mesh": 0 }]);
+    body["scenes"] = json!([{ "nodes": [0] }, {}]);
+    body["scene"] = json!(0);
+    body["animations"] = json!([{
+        "channels": [{ "sampler": 0, "target": { "path": "pointer" } }],
+        "samplers": [{ "input": 0, "output": 0 }],
+    }]);
+    let raw = parse_gltf(&gltf_text(&bin, body.clone()), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    // The empty scene, chosen, draws nothing: no triangle, no error here
+    // (the cleaning step reports the empty mesh).
+    body["scene"] = json!(1);
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert!(raw.triangles.is_empty());
+}
+
+/// A GLB whose header length leaves bytes after it (the validator's
+/// GLB_EXTRA_DATA, a warning): the chunks within the length are read. A
+/// length past the file's end is still a truncated file.
+#[test]
+fn bytes_after_a_glb_s_declared_length_are_ignored() {
+    let mut bin = Bin::default();
+    let body = triangle_asset(&mut bin);
+    let (mut file, _) = glb(&bin, body);
+    let mut longer = file.clone();
+    longer.push(0);
+    let raw = parse_gltf(&longer, Path::new("t.glb")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    let n = file.len() as u32 + 4;
+    file[8..12].copy_from_slice(&n.to_le_bytes());
+    let (place, message) = parse_failure(&file, "t.glb");
+    assert_eq!(place.byte, Some(8));
+    assert!(message.contains("truncated"), "{message}");
+}
+
+/// A triangle list of 4 indices (the validator's
+/// MESH_PRIMITIVE_INCOMPATIBLE_MODE, a warning) draws its whole triangle.
+#[test]
+fn a_list_whose_count_is_not_a_multiple_of_3_draws_its_whole_triangles() {
+    let mut bin = Bin::default();
+    let p = bin.f32s(&[0., 0., 0., 1., 0., 0., 0., 1., 0., 1., 1., 0.]);
+    let body = json!({
+        "bufferViews": [view(p)],
+        "accessors": [accessor(0, FLOAT, "VEC3", 4)],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 } }] }],
+    });
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+}
+
+/// A primitive without POSITION is skipped (a client should not render
+/// it), as is one whose data lie in a buffer with no uri in a `.gltf`
+/// (no bytes anywhere); the others are read.
+#[test]
+fn primitives_without_positions_or_data_are_skipped() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    let good = body["meshes"][0]["primitives"][0].clone();
+    body["meshes"][0]["primitives"] = json!([{ "attributes": { "NORMAL": 1 } }, good]);
+    let raw = parse_gltf(&gltf_text(&bin, body.clone()), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    assert_eq!(
+        mts::mesh::io::gltf_part_count(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap(),
+        1
+    );
+    // The same data in a buffer without uri: nothing to draw, and so no
+    // triangle (the error is the cleaning step's "empty mesh").
+    let mut body = triangle_asset(&mut bin);
+    body["asset"] = json!({ "version": "2.0" });
+    body["buffers"] = json!([{ "byteLength": bin.0.len() }]);
+    let text = serde_json::to_vec(&body).unwrap();
+    assert!(parse_gltf(&text, Path::new("t.gltf"))
+        .unwrap()
+        .triangles
+        .is_empty());
+    match load_bytes(&text, Path::new("t.gltf")) {
+        Err(Error::InvalidMesh { .. }) => {}
+        other => panic!("expected an empty mesh, got {other:?}"),
+    }
+}
+
+/// The base-colour texture's KHR_texture_transform applies to TEXCOORD_0,
+/// checked on the extension's own example (offset [0, 1], rotation π/2,
+/// scale [0.5, 0.5]: the lower-left quadrant, rotated); then `v` is
+/// flipped as for every glTF coordinate.
+#[test]
+fn texture_transforms_apply_to_the_coordinates() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    let t = bin.f32s(&[0., 0., 1., 0., 0., 1.]);
+    body["bufferViews"].as_array_mut().unwrap().push(view(t));
+    body["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(accessor(3, FLOAT, "VEC2", 3));
+    body["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(3);
+    body["meshes"][0]["primitives"][0]["material"] = json!(0);
+    body["materials"] = json!([{ "pbrMetallicRoughness": { "baseColorTexture": {
+        "index": 0,
+        "extensions": { "KHR_texture_transform": {
+            "offset": [0, 1], "rotation": std::f64::consts::FRAC_PI_2, "scale": [0.5, 0.5] } },
+    } } }]);
+    body["textures"] = json!([{ "source": 0 }]);
+    body["images"] = json!([{ "uri": "missing.png" }]);
+    body["extensionsUsed"] = json!(["KHR_texture_transform"]);
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    let uvs = raw.properties.uvs.unwrap();
+    // glTF (u, v) -> (0.5 v, 1 - 0.5 u), then v -> 1 - v.
+    let want = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(0.0, 0.5),
+        Vec2::new(0.5, 0.0),
+    ];
+    for (got, want) in uvs.iter().zip(want) {
+        assert!((*got - want).abs().max_element() < 1e-6, "{got} {want}");
+    }
+}
+
+/// A texture whose image is only in KHR_texture_basisu (no `source`) is
+/// drawn untextured, its geometry read, even where the extension is
+/// required.
+#[test]
+fn basisu_textures_leave_the_mesh_untextured() {
+    let mut bin = Bin::default();
+    let mut body = triangle_asset(&mut bin);
+    body["meshes"][0]["primitives"][0]["material"] = json!(0);
+    body["materials"] = json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }]);
+    body["textures"] = json!([{ "extensions": { "KHR_texture_basisu": { "source": 0 } } }]);
+    body["images"] = json!([{ "uri": "t.ktx2", "mimeType": "image/ktx2" }]);
+    body["extensionsUsed"] = json!(["KHR_texture_basisu"]);
+    body["extensionsRequired"] = json!(["KHR_texture_basisu"]);
+    let raw = parse_gltf(&gltf_text(&bin, body.clone()), Path::new("t.gltf")).unwrap();
+    assert_eq!(raw.triangles, [[0, 1, 2]]);
+    assert!(raw.properties.texture.is_none());
+    // With a KTX2 image as `source` itself: the same.
+    body["textures"] = json!([{ "source": 0 }]);
+    let raw = parse_gltf(&gltf_text(&bin, body), Path::new("t.gltf")).unwrap();
+    assert!(raw.properties.texture.is_none());
 }

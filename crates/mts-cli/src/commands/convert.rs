@@ -9,14 +9,17 @@ use std::path::PathBuf;
 pub struct ConvertArgs {
     #[command(flatten)]
     pub source: MeshSource,
-    /// The OBJ file to write.
+    /// The file to write (.obj, .ply, .glb or .gltf, by extension).
     #[arg(short, long)]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub gltf: GltfOut,
 }
 
 pub fn run(args: &ConvertArgs) -> Result<()> {
     args.source.check_output(&args.output)?;
+    args.gltf.check(&args.output)?;
     let (_, mesh, _) = args.source.load()?;
-    super::save_mesh(&mesh, &args.output)?;
+    super::save_mesh_as(&mesh, &args.output, args.gltf)?;
     Ok(())
 }

@@ -19,6 +19,8 @@ pub struct ExtractArgs {
     /// Write the extracted triangles (.obj, .ply, .glb or .gltf, by extension).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub gltf: GltfOut,
     /// Timed extractions from scratch (1 to 10,000); the median is reported.
     #[arg(long, default_value_t = 11, value_parser = count_in::<1, MAX_REPEAT>, allow_negative_numbers = true)]
     pub repeat: usize,
@@ -42,6 +44,7 @@ pub fn run(args: &ExtractArgs) -> Result<()> {
     use mts::Extractor;
     if let Some(out) = &args.output {
         args.source.check_output(out)?;
+        args.gltf.check(out)?;
     }
     if args.method != Method::Mts {
         return extract_baseline(args);
@@ -135,7 +138,7 @@ fn extract_timed<'m>(
         // the input vertices' (a model with properties has no created
         // vertices: endpoint placement).
         let mesh = Mesh::level(model.positions(), &ex.triangles(), model.properties());
-        super::save_mesh(&mesh, out)?;
+        super::save_mesh_as(&mesh, out, args.gltf)?;
         vertices_written = Some(mesh.vertex_count());
     }
     Ok(Extracted {
@@ -262,7 +265,7 @@ fn extract_baseline(args: &ExtractArgs) -> Result<()> {
     let triangles = source.triangles();
     if let Some(out) = &args.output {
         let m = Mesh::level(&mesh.positions, &triangles, &mesh.properties);
-        super::save_mesh(&m, out)?;
+        super::save_mesh_as(&m, out, args.gltf)?;
     }
     let method = source.name();
     if args.json {

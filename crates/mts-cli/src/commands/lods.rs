@@ -3,7 +3,7 @@
 //! the recorded errors; each level an indexed list in vertex-cache order
 //! holding only its own vertices). See [`mts::mesh::io::save_lod_chain`].
 
-use crate::args::{pixel_error, MeshSource};
+use crate::args::{pixel_error, GltfOut, MeshSource};
 use crate::stdout::{outln, warnln};
 use anyhow::{bail, Result};
 use clap::Args;
@@ -23,6 +23,8 @@ pub struct LodsArgs {
     /// The glTF file to write (.glb or .gltf, by extension).
     #[arg(short, long)]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub gltf: GltfOut,
     /// The screen-coverage hints let a level show at most this error, in
     /// pixels ...
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true, value_parser = pixel_error)]
@@ -90,7 +92,7 @@ pub fn run(args: &LodsArgs) -> Result<()> {
             lost.join(", ")
         );
     }
-    save_lod_chain(&levels, &coverage, &args.output)?;
+    save_lod_chain(&levels, &coverage, &args.output, args.gltf.encoding())?;
     let bytes = std::fs::metadata(&args.output).map_or(0, |m| m.len());
     let errors: Vec<f32> = levels.iter().map(|l| l.error).collect();
     let coverages = screen_coverages(&errors, &coverage);

@@ -21,6 +21,24 @@ pub mod view;
 /// what the format cannot hold of the mesh's properties is named in one
 /// warning.
 pub fn save_mesh(mesh: &mts::Mesh, path: &std::path::Path) -> anyhow::Result<()> {
+    save_mesh_as(mesh, path, crate::args::GltfOut::default())
+}
+
+/// [`save_mesh`] with the glTF encoding `out` asks for: quantized or
+/// compressed levels are written in vertex-cache order (triangles, then
+/// vertices in order of first use), what the codecs and GPUs do best with.
+pub fn save_mesh_as(
+    mesh: &mts::Mesh,
+    path: &std::path::Path,
+    out: crate::args::GltfOut,
+) -> anyhow::Result<()> {
+    let encoding = out.encoding();
+    if encoding != mts::mesh::io::Encoding::Plain {
+        out.check(path)?;
+        let ordered = mts::mesh::io::order_for_cache(mesh);
+        mts::mesh::io::save_gltf_as(&ordered, path, encoding)?;
+        return Ok(());
+    }
     let lost = mts::mesh::io::dropped_by(mesh, path);
     if !lost.is_empty() {
         crate::stdout::warnln!(

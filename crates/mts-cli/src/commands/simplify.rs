@@ -25,6 +25,8 @@ pub struct SimplifyArgs {
     /// Write the simplified mesh (.obj, .ply, .glb or .gltf, by extension): the level's own vertices with their properties.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub gltf: GltfOut,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -59,6 +61,7 @@ pub struct SimplifyArgs {
 pub fn run(args: &SimplifyArgs) -> Result<()> {
     if let Some(out) = &args.output {
         args.source.check_output(out)?;
+        args.gltf.check(out)?;
     }
     use mts::distance::surface_distance;
     use mts::peers::quality::{self, Measurement};
@@ -141,7 +144,7 @@ pub fn run(args: &SimplifyArgs) -> Result<()> {
         (lod, d, serde_json::Value::Null)
     };
     if let Some(path) = &args.output {
-        super::save_mesh(&collapses.mesh_at(&mesh, lod), path)?;
+        super::save_mesh_as(&collapses.mesh_at(&mesh, lod), path, args.gltf)?;
     }
     let v = json!({
         "mesh": name,

@@ -91,6 +91,7 @@
 //! seam (vertices are split per primitive and per attribute value alike);
 //! [`crate::mesh::CleanOptions::weld`] merges bit-identical positions.
 
+use super::gltf_meshopt::{self, Compressed};
 use super::read_file;
 use crate::error::{Error, Place, Result};
 use crate::mesh::{RawMesh, Texture};
@@ -105,9 +106,20 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Extensions a file may require that this reader honours: quantized
-/// attributes are read through the generic component decoding, and unlit
-/// materials change no geometry or texture.
-const SUPPORTED_REQUIRED: &[&str] = &["KHR_mesh_quantization", "KHR_materials_unlit"];
+/// attributes are read through the generic component decoding; unlit
+/// materials change no geometry or texture; compressed buffer views are
+/// decoded ([`gltf_meshopt`]); the base-colour texture's
+/// `KHR_texture_transform` is applied to `TEXCOORD_0`; a
+/// `KHR_texture_basisu` (KTX2) image, which nothing here decodes, leaves
+/// the mesh untextured with a note, its geometry read.
+const SUPPORTED_REQUIRED: &[&str] = &[
+    "KHR_mesh_quantization",
+    "KHR_materials_unlit",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
+    "KHR_texture_transform",
+    "KHR_texture_basisu",
+];
 
 /// Parses a `.gltf` or `.glb` file (told apart by the GLB magic `glTF`)
 /// into one [`RawMesh`], as described in the module docs: every instance
@@ -144,8 +156,8 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<RawMesh> {
 /// As [`parse_gltf`]; [`Error::Parse`] naming the primitive whose instance
 /// passes the limit.
 pub fn parse_gltf_with(bytes: &[u8], path: &Path, max_triangles: u64) -> Result<RawMesh> {
-    let (root, bin) = parse_container(bytes, path)?;
-    let mut reader = Reader::new(&root, path, bin, max_triangles, Target::Merged);
+    let (root, bin, beside) = parse_container(bytes, path)?;
+    let mut reader = Reader::new(&root, path, bin, beside, max_triangles, Target::Merged);
     reader.check_extensions()?;
     reader.read_scene()?;
     reader.finish()
@@ -208,13 +220,13 @@ pub struct GltfPart {
 /// Cost: O(file size + parts' data); a mesh's data is read once however
 /// many nodes hold it, each further instance costs one matrix.
 pub fn parse_gltf_parts(bytes: &[u8], path: &Path, max_triangles: u64) -> Result<Vec<GltfPart>> {
-    let (root, bin) = parse_container(bytes, path)?;
+    let (root, bin, beside) = parse_container(bytes, path)?;
     let target = Target::Parts {
         parts: Vec::new(),
         of_mesh: HashMap::new(),
         images: HashMap::new(),
     };
-    let mut reader = Reader::new(&root, path, bin, max_triangles, target);
+    let mut reader = Reader::new(&root, path, bin, beside, max_triangles, target);
     reader.check_extensions()?;
     reader.read_scene()?;
     match reader.target {
@@ -236,12 +248,12 @@ pub fn parse_gltf_parts(bytes: &[u8], path: &Path, max_triangles: u64) -> Result
 ///
 /// Cost: O(JSON size + nodes); nothing is allocated per vertex.
 pub fn gltf_part_count(bytes: &[u8], path: &Path) -> Result<usize> {
-    let (root, bin) = parse_container(bytes, path)?;
+    let (root, bin, beside) = parse_container(bytes, path)?;
     let target = Target::Count {
         meshes: HashSet::new(),
         parts: 0,
     };
-    let mut reader = Reader::new(&root, path, bin, u64::MAX, target);
+    let mut reader = Reader::new(&root, path, bin, beside, u64::MAX, target);
     reader.check_extensions()?;
     reader.read_scene()?;
     match reader.target {
@@ -250,15 +262,98 @@ pub fn gltf_part_count(bytes: &[u8], path: &Path) -> Result<usize> {
     }
 }
 
-/// The typed document of a `.gltf` or `.glb` file and its BIN chunk.
-fn parse_container<'a>(bytes: &'a [u8], path: &Path) -> Result<(json::Root, Bin<'a>)> {
+/// The typed document of a `.gltf` or `.glb` file, its BIN chunk, and
+/// what the reader takes from the JSON beside the typed model.
+fn parse_container<'a>(bytes: &'a [u8], path: &Path) -> Result<(json::Root, Bin<'a>, Beside)> {
     let is_glb = bytes.starts_with(b"glTF");
     let (text, bin) = if is_glb {
         split_glb(bytes, path)?
     } else {
         (bytes, None)
     };
-    Ok((parse_document(text, path, is_glb)?, bin))
+    let (root, beside) = parse_document(text, path, is_glb)?;
+    Ok((root, bin, beside))
+}
+
+/// What the reader takes from the document's JSON that the typed model
+/// (gltf-json without its `extensions` feature) does not hold: the
+/// compressed buffer views ([`gltf_meshopt`]) and each material's
+/// base-colour `KHR_texture_transform`.
+#[derive(Default)]
+struct Beside {
+    /// One entry per buffer view; `None` for a plain view.
+    compressed: Vec<Option<Compressed>>,
+    /// The transform of the base-colour texture's coordinates, by
+    /// material: `(u, v) -> (a u + b v + c, d u + e v + f)` as
+    /// `[a, b, c, d, e, f]`.
+    uv_transforms: HashMap<usize, [f32; 6]>,
+}
+
+impl Beside {
+    /// Reads them from the document `value`.
+    ///
+    /// # Errors
+    /// The place (a buffer view or a material) and what is wrong there.
+    fn of(value: &Value) -> std::result::Result<Beside, (Place, String)> {
+        let compressed = gltf_meshopt::compressed_views(value)
+            .map_err(|(v, m)| (Place::element("bufferView", v as u64), m))?;
+        let mut uv_transforms = HashMap::new();
+        let materials = value.get("materials").and_then(Value::as_array);
+        for (i, material) in materials.into_iter().flatten().enumerate() {
+            let Some(t) = material
+                .pointer("/pbrMetallicRoughness/baseColorTexture/extensions/KHR_texture_transform")
+            else {
+                continue;
+            };
+            let m = uv_transform(t).map_err(|m| (Place::element("material", i as u64), m))?;
+            uv_transforms.insert(i, m);
+        }
+        Ok(Beside {
+            compressed,
+            uv_transforms,
+        })
+    }
+}
+
+/// The affine map of a `KHR_texture_transform` object: `offset`,
+/// `rotation` (radians) and `scale`, applied as translation × rotation ×
+/// scale: `u' = cos·sx·u + sin·sy·v + ox`, `v' = −sin·sx·u + cos·sy·v +
+/// oy`. **Decision:** the extension's GLSL writes the rotation matrix's
+/// columns in an order that reads the other way round in some copies; its
+/// own worked example (offset `[0, 1]`, rotation π/2, scale `[0.5, 0.5]`
+/// samples the lower-left quadrant, inside `[0, 1]`) holds only for the
+/// signs used here, so the example decides (tested).
+fn uv_transform(t: &Value) -> std::result::Result<[f32; 6], String> {
+    let numbers = |key: &str, default: &[f64]| -> std::result::Result<Vec<f64>, String> {
+        match t.get(key) {
+            None => Ok(default.to_vec()),
+            Some(Value::Number(n)) if default.len() == 1 => Ok(vec![n.as_f64().unwrap_or(0.0)]),
+            Some(Value::Array(a)) if a.len() == default.len() && a.iter().all(Value::is_number) => {
+                Ok(a.iter().map(|x| x.as_f64().unwrap_or(0.0)).collect())
+            }
+            Some(other) => Err(format!(
+                "KHR_texture_transform: `{key}` is {other}, not {} number{}",
+                default.len(),
+                if default.len() == 1 { "" } else { "s" }
+            )),
+        }
+    };
+    let offset = numbers("offset", &[0.0, 0.0])?;
+    let rotation = numbers("rotation", &[0.0])?[0];
+    let scale = numbers("scale", &[1.0, 1.0])?;
+    let (sin, cos) = rotation.sin_cos();
+    let m = [
+        cos * scale[0],
+        sin * scale[1],
+        offset[0],
+        -sin * scale[0],
+        cos * scale[1],
+        offset[1],
+    ];
+    if m.iter().any(|x| !x.is_finite()) {
+        return Err("KHR_texture_transform: a value is not finite".into());
+    }
+    Ok(m.map(|x| x as f32))
 }
 
 /// The typed document of the JSON `text`, after the checks the typed model
@@ -277,7 +372,7 @@ fn parse_container<'a>(bytes: &'a [u8], path: &Path) -> Result<(json::Root, Bin<
 /// Cost: O(text) time: the text is parsed twice (as a `serde_json::Value`,
 /// then typed), three times when the typed parse fails; one of these
 /// copies is held at a time.
-fn parse_document(text: &[u8], path: &Path, is_glb: bool) -> Result<json::Root> {
+fn parse_document(text: &[u8], path: &Path, is_glb: bool) -> Result<(json::Root, Beside)> {
     let fail = |place: Place, message: String| Error::Parse {
         file: path.to_owned(),
         place,
@@ -299,18 +394,19 @@ fn parse_document(text: &[u8], path: &Path, is_glb: bool) -> Result<json::Root> 
     check_asset(&value).map_err(|m| fail(place_of(&[Step::Key("asset")]), m))?;
     let mut steps = Vec::new();
     check_integers(&value, None, &mut steps).map_err(|m| fail(place_of(&steps), m))?;
+    let beside = Beside::of(&value).map_err(|(place, m)| fail(place, m))?;
     // Not held while the typed model is: a document is read twice, but
     // held once at a time.
     drop(value);
     let typed = match json::deserialize::from_slice(text) {
-        Ok(root) => return Ok(root),
+        Ok(root) => return Ok((root, beside)),
         Err(typed) => typed,
     };
     let mut value: Value = serde_json::from_slice(text).map_err(|e| not_gltf(&e))?;
-    if !drop_extras(&mut value) {
+    if !lenient(&mut value) {
         return Err(not_gltf(&typed));
     }
-    json::deserialize::from_value(value).map_err(|e| {
+    let root = json::deserialize::from_value(value).map_err(|e| {
         // The same complaint as the text's: the text's line is its place.
         let bare = e.to_string();
         let located = typed.to_string();
@@ -325,12 +421,75 @@ fn parse_document(text: &[u8], path: &Path, is_glb: bool) -> Result<json::Root> 
             fail(
                 Place::default(),
                 format!(
-                    "{}not a glTF document (its extras set aside): {bare}",
+                    "{}not a glTF document (read leniently): {bare}",
                     if is_glb { "JSON chunk: " } else { "" }
                 ),
             )
         }
-    })
+    })?;
+    Ok((root, beside))
+}
+
+/// Makes of a document the typed model refused one it may take, where
+/// the specification allows what the model does not; returns whether
+/// anything changed. What the model is stricter about than glTF 2.0:
+///
+/// - `extras` may be any JSON value; the model takes only an object. Every
+///   `extras` is dropped (the reader uses none).
+/// - An integer may be written with a zero fraction (`1.0`): JSON has one
+///   number type, and the validator reads `1.0` as the integer 1. Every
+///   number with no fraction becomes an integer (a float field still
+///   reads it as a float).
+/// - `animations`, `skins` and `cameras` are not read, and the model
+///   requires fields the specification leaves optional there (an
+///   animation channel's `target.node`, absent when `KHR_animation_pointer`
+///   names the target): they are dropped whole.
+/// - A scene's `nodes` is optional (a scene may be empty); the model
+///   requires it: an empty list is written in.
+fn lenient(value: &mut Value) -> bool {
+    let mut changed = drop_extras(value);
+    changed |= integral_numbers(value);
+    if let Value::Object(top) = value {
+        for unread in ["animations", "skins", "cameras"] {
+            changed |= top.remove(unread).is_some();
+        }
+        if let Some(Value::Array(scenes)) = top.get_mut("scenes") {
+            for scene in scenes.iter_mut().filter_map(Value::as_object_mut) {
+                if !scene.contains_key("nodes") {
+                    scene.insert("nodes".into(), Value::Array(Vec::new()));
+                    changed = true;
+                }
+            }
+        }
+    }
+    changed
+}
+
+/// Rewrites every finite number with no fraction, within ±2^53, written as
+/// a float (`4.0`) as an integer; returns whether any was. Walks without
+/// recursion (a document may nest deeply).
+fn integral_numbers(value: &mut Value) -> bool {
+    let mut changed = false;
+    let mut stack = vec![value];
+    while let Some(v) = stack.pop() {
+        match v {
+            Value::Number(n) if n.is_f64() => {
+                let f = n.as_f64().unwrap_or(f64::NAN);
+                if f.fract() == 0.0 && f.abs() < (1u64 << 53) as f64 {
+                    *v = if f < 0.0 {
+                        Value::from(f as i64)
+                    } else {
+                        Value::from(f as u64)
+                    };
+                    changed = true;
+                }
+            }
+            Value::Array(a) => stack.extend(a.iter_mut()),
+            Value::Object(o) => stack.extend(o.values_mut()),
+            _ => {}
+        }
+    }
+    changed
 }
 
 /// Refuses an `asset.version` whose major version is not 2, and an
@@ -559,6 +718,7 @@ type Bin<'a> = Option<(&'a [u8], u64)>;
 /// Splits a GLB file into its JSON chunk and optional BIN chunk, checking
 /// the header and every chunk against the file's length.
 fn split_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<(&'a [u8], Bin<'a>)> {
+    use std::io::Write as _;
     let fail = |byte: usize, element: &str, index: Option<u64>, message: String| Error::Parse {
         file: path.to_owned(),
         place: Place {
@@ -636,7 +796,17 @@ fn split_glb<'a>(bytes: &'a [u8], path: &Path) -> Result<(&'a [u8], Bin<'a>)> {
         at = data_end.next_multiple_of(4);
         chunk += 1;
     }
-    if length as usize != bytes.len() {
+    if (length as usize) < bytes.len() && length >= 12 {
+        // Bytes after the declared length: the validator's GLB_EXTRA_DATA
+        // is a warning, and the chunks within the length are whole (each
+        // was checked to end inside it or before the file's end).
+        let _ = writeln!(
+            std::io::stderr(),
+            "note: {}: {} bytes after the GLB's declared length of {length}: ignored",
+            path.display(),
+            bytes.len() - length as usize
+        );
+    } else if length as usize != bytes.len() {
         return Err(fail(
             8,
             "GLB header",
@@ -752,6 +922,11 @@ struct Reader<'a> {
     notes: HashSet<String>,
     /// What the walk over the scene makes.
     target: Target,
+    /// The extension objects read beside the typed model.
+    beside: Beside,
+    /// Compressed buffer views decoded so far: the view's index, and the
+    /// slot of `buffers` (past the file's buffers) holding its bytes.
+    decoded: HashMap<usize, usize>,
 }
 
 /// What a [`Reader`] makes of the meshes the scene reaches.
@@ -779,6 +954,7 @@ impl<'a> Reader<'a> {
         root: &'a json::Root,
         path: &'a Path,
         bin: Bin<'a>,
+        beside: Beside,
         max_triangles: u64,
         target: Target,
     ) -> Reader<'a> {
@@ -796,6 +972,8 @@ impl<'a> Reader<'a> {
             max_triangles,
             notes: HashSet::new(),
             target,
+            beside,
+            decoded: HashMap::new(),
         }
     }
 
@@ -986,7 +1164,10 @@ impl<'a> Reader<'a> {
                         let Checked::Valid(mode) = primitive.mode else {
                             return Err(self.fail(place, "unknown primitive mode".into()));
                         };
-                        if is_triangles(mode) {
+                        let positions = primitive
+                            .attributes
+                            .contains_key(&Checked::Valid(Semantic::Positions));
+                        if is_triangles(mode) && positions {
                             *parts += 1;
                         }
                     }
@@ -1025,8 +1206,25 @@ impl<'a> Reader<'a> {
                 .map(|a| a.value())
         };
         let Some(pa) = attribute(Semantic::Positions) else {
-            return Err(self.fail(place.clone(), "no POSITION attribute".into()));
+            // glTF 2.0, "Meshes": without positions a client should skip
+            // the primitive's rendering.
+            self.note(format!("{place} has no POSITION attribute: skipped"));
+            return Ok(None);
         };
+        let used = primitive
+            .attributes
+            .values()
+            .map(|a| a.value())
+            .chain(primitive.indices.map(|a| a.value()));
+        if let Some(b) = used.filter_map(|a| self.dataless_buffer(a)).next() {
+            // A buffer of a .gltf without uri has no bytes anywhere: the
+            // validator lets it be, and there is nothing to draw.
+            self.note(format!(
+                "{place} reads buffer {b}, which has no uri (and is not a .glb's BIN chunk), so \
+                 no data: skipped"
+            ));
+            return Ok(None);
+        }
         let positions = self.elements(pa, &[3], "POSITION", place)?;
         let count = positions.count;
         self.count_vertices(count, place)?;
@@ -1051,6 +1249,16 @@ impl<'a> Reader<'a> {
                     ));
                 }
                 streams[slot] = Some((self.floats(a, &e)?, e.dims));
+            }
+        }
+        let transform = primitive
+            .material
+            .and_then(|m| self.beside.uv_transforms.get(&m.value()));
+        if let (Some(m), Some((uvs, _))) = (transform, streams[1].as_mut()) {
+            for uv in uvs.chunks_exact_mut(2) {
+                let (u, v) = (uv[0], uv[1]);
+                uv[0] = m[0] * u + m[1] * v + m[2];
+                uv[1] = m[3] * u + m[4] * v + m[5];
             }
         }
         let indices = match primitive.indices {
@@ -1291,7 +1499,12 @@ impl<'a> Reader<'a> {
     /// `(i, i + 1 + i % 2, i + 2 - i % 2)`, fan triangle `i` is
     /// `(i + 1, i + 2, 0)`; and the degenerate strip and fan triangles (a
     /// strip's joins) dropped, for [`RawMesh::degenerate_in_source`].
-    fn triangles(&self, mode: Mode, ix: &[u32], place: &Place) -> Result<(Vec<[u32; 3]>, usize)> {
+    fn triangles(
+        &mut self,
+        mode: Mode,
+        ix: &[u32],
+        place: &Place,
+    ) -> Result<(Vec<[u32; 3]>, usize)> {
         let n = ix.len();
         let mut out = Vec::with_capacity(if mode == Mode::Triangles {
             n / 3
@@ -1301,10 +1514,14 @@ impl<'a> Reader<'a> {
         let mut degenerate = 0;
         match mode {
             Mode::Triangles => {
+                // A count that is not a multiple of 3 is the validator's
+                // MESH_PRIMITIVE_INCOMPATIBLE_MODE, a warning: the whole
+                // triangles are drawn, the rest left (as a GPU does).
                 if n % 3 != 0 {
-                    return Err(self.fail(
-                        place.clone(),
-                        format!("{n} indices for a triangle list, not a multiple of 3"),
+                    self.note(format!(
+                        "{place}: {n} indices for a triangle list, not a multiple of 3: the \
+                         last {} are not drawn",
+                        n % 3
                     ));
                 }
                 out.extend(ix.chunks_exact(3).map(|t| [t[0], t[1], t[2]]));
@@ -1382,6 +1599,19 @@ impl<'a> Reader<'a> {
             ));
         };
         let image = texture.source.value();
+        if image == u32::MAX as usize {
+            // The model's value for an absent `source`: the image is only
+            // in an extension (KHR_texture_basisu, EXT_texture_webp).
+            self.note(format!(
+                "texture {ti} has its image only in an extension (such as KHR_texture_basisu), \
+                 which this reader does not decode: drawn untextured"
+            ));
+            return Ok(Material {
+                index: Some(mi),
+                factor,
+                image: None,
+            });
+        }
         if info.tex_coord != 0 {
             self.note(format!(
                 "material {mi}'s base-colour texture uses TEXCOORD_{}; only TEXCOORD_0 is read",
@@ -1454,6 +1684,18 @@ impl<'a> Reader<'a> {
         };
         let place = Place::element("image", i as u64);
         let mime = image.mime_type.as_ref().map(|m| m.0.clone());
+        let ktx2 = mime.as_deref() == Some("image/ktx2")
+            || image
+                .uri
+                .as_deref()
+                .is_some_and(|u| u.to_ascii_lowercase().ends_with(".ktx2"));
+        if ktx2 {
+            self.note(format!(
+                "image {i} is KTX2 (KHR_texture_basisu), which this reader does not decode: \
+                 drawn untextured"
+            ));
+            return Ok(None);
+        }
         if let Some(view) = image.buffer_view {
             let (buffer, range) = self.view_range(view.value(), &place)?;
             let bytes = self.buffers[buffer]
@@ -1562,6 +1804,9 @@ impl<'a> Reader<'a> {
             ));
         };
         let vplace = Place::element("bufferView", v as u64);
+        if let Some(c) = self.beside.compressed.get(v).cloned().flatten() {
+            return self.decoded_view(v, &c);
+        }
         let b = view.buffer.value();
         self.load_buffer(b, &vplace)?;
         let declared = root.buffers[b].byte_length.0;
@@ -1577,6 +1822,84 @@ impl<'a> Reader<'a> {
                 ),
             )),
         }
+    }
+
+    /// The buffer without data (no uri, and not buffer 0 of a `.glb` with
+    /// a BIN chunk) that accessor `a` reads, if any; out-of-range indices
+    /// are left to the checks that report them.
+    fn dataless_buffer(&self, a: usize) -> Option<usize> {
+        let root = self.root;
+        let accessor = root.accessors.get(a)?;
+        let sparse = accessor.sparse.as_ref();
+        let views = accessor
+            .buffer_view
+            .map(|v| v.value())
+            .into_iter()
+            .chain(sparse.map(|s| s.indices.buffer_view.value()))
+            .chain(sparse.map(|s| s.values.buffer_view.value()));
+        views
+            .filter_map(|v| {
+                let b = match self.beside.compressed.get(v) {
+                    Some(Some(c)) => c.buffer,
+                    _ => root.buffer_views.get(v)?.buffer.value(),
+                };
+                let dataless =
+                    root.buffers.get(b)?.uri.is_none() && !(b == 0 && self.bin.is_some());
+                dataless.then_some(b)
+            })
+            .next()
+    }
+
+    /// Compressed buffer view `v` ([`gltf_meshopt`]), decoded once into a
+    /// slot of `buffers` past the file's own: that slot and the range of
+    /// its bytes. The view's own `buffer` (a fallback, often without data)
+    /// is not read.
+    fn decoded_view(
+        &mut self,
+        v: usize,
+        c: &Compressed,
+    ) -> Result<(usize, std::ops::Range<usize>)> {
+        let vplace = Place::element("bufferView", v as u64);
+        let length = c.decoded_len() as usize;
+        if let Some(&slot) = self.decoded.get(&v) {
+            return Ok((slot, 0..length));
+        }
+        let b = c.buffer;
+        self.load_buffer(b, &vplace)?;
+        let declared = self.root.buffers[b].byte_length.0;
+        let Some(end) = c.offset.checked_add(c.length).filter(|&e| e <= declared) else {
+            return Err(self.fail(
+                vplace,
+                format!(
+                    "{}: compressed bytes {}..{}+{} lie beyond buffer {b} ({declared} bytes)",
+                    c.extension, c.offset, c.offset, c.length
+                ),
+            ));
+        };
+        let buffer = self.loaded(b);
+        let bytes = &buffer.bytes[c.offset as usize..end as usize];
+        let max_count = self.max_triangles.saturating_mul(3);
+        let decoded = gltf_meshopt::decode(c, bytes, max_count).map_err(|m| {
+            let place = Place {
+                byte: buffer.base.map(|base| base.saturating_add(c.offset)),
+                ..vplace.clone()
+            };
+            self.fail(
+                place,
+                format!(
+                    "{}: the {} compressed bytes from byte {} of buffer {b} ({}): {m}",
+                    c.extension, c.length, c.offset, buffer.origin
+                ),
+            )
+        })?;
+        self.buffers.push(Some(Buffer {
+            bytes: Cow::Owned(decoded),
+            base: None,
+            origin: format!("buffer view {v} as decoded ({})", c.extension),
+        }));
+        let slot = self.buffers.len() - 1;
+        self.decoded.insert(v, slot);
+        Ok((slot, 0..length))
     }
 
     /// Accessor `a`'s layout, checked: a type of `dims` components; base

@@ -33,9 +33,10 @@
 //! up to 2^24 texels wide); elsewhere `1 - (1 - v)` may differ from `v` by
 //! up to 2^-25 (half an ulp of 1.0).
 
+use super::gltf_compress::{self, Grid};
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, Texture};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -44,6 +45,8 @@ use std::path::Path;
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const FLOAT: u32 = 5126;
+const BYTE: u32 = 5120;
+const UNSIGNED_BYTE: u32 = 5121;
 const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
 const TRIANGLES: u32 = 4;
@@ -65,14 +68,29 @@ const TRIANGLES: u32 = 4;
 /// Cost: O(V + T); the buffer is built in memory (about 52 bytes per vertex
 /// with every property, 12 per triangle) before it is written.
 pub fn save_gltf(mesh: &Mesh, path: &Path) -> Result<()> {
+    save_gltf_as(mesh, path, Encoding::Plain)
+}
+
+/// [`save_gltf`] with the vertex data stored as `encoding` says
+/// ([`Encoding::Quantized`], [`Encoding::Compressed`]: positions on a
+/// 14-bit grid placed by the node's transform, the other attributes as
+/// [`super::gltf_compress`] lists). The triangles and vertices are written
+/// in `mesh`'s order: for the codecs to do well, give a mesh in
+/// vertex-cache order ([`super::order_for_cache`]).
+///
+/// # Errors
+/// As [`save_gltf`].
+pub fn save_gltf_as(mesh: &Mesh, path: &Path, encoding: Encoding) -> Result<()> {
     let binary = is_binary(path)?;
-    let mut out = Document::default();
+    let mut out = Document::new(encoding, &mesh.positions);
     let mut primitive = out.primitive(mesh, path)?;
+    let mut node = json!({ "mesh": 0 });
+    out.place_node(&mut node);
     let mut root = json!({
         "asset": { "version": "2.0", "generator": "mts" },
         "scene": 0,
         "scenes": [{ "nodes": [0] }],
-        "nodes": [{ "mesh": 0 }],
+        "nodes": [node],
     });
     if let Some(texture) = &mesh.properties.texture {
         out.material(&mut root, texture, binary, path)?;
@@ -101,15 +119,57 @@ pub(super) fn is_binary(path: &Path) -> Result<bool> {
     }
 }
 
+/// How a glTF file's vertex data are stored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Encoding {
+    /// Floats and u16/u32 indices, exact (the default).
+    #[default]
+    Plain,
+    /// Attributes quantized (`KHR_mesh_quantization`, the layout of
+    /// [`super::gltf_compress`]), views uncompressed.
+    Quantized,
+    /// Quantized, then every vertex and index view coded with
+    /// meshoptimizer's codecs (`EXT_meshopt_compression`): what gltfpack
+    /// `-cc` writes, read by any loader with meshoptimizer's decoder.
+    Compressed,
+}
+
 /// The buffer and the views and accessors into it, as they are built.
 #[derive(Default)]
 pub(super) struct Document {
     bin: Vec<u8>,
     views: Vec<Value>,
     accessors: Vec<Value>,
+    encoding: Encoding,
+    /// The positions' grid, for [`Encoding::Quantized`] and
+    /// [`Encoding::Compressed`].
+    grid: Option<Grid>,
+    /// The length of the fallback buffer (buffer 1, no data) that the
+    /// compressed views decode into.
+    fallback: usize,
 }
 
 impl Document {
+    /// A document whose data are stored as `encoding` says; a quantized one
+    /// puts every position on the grid over `points` (all the levels'
+    /// positions, so that levels share one grid and one node transform).
+    pub(super) fn new<'a>(encoding: Encoding, points: impl IntoIterator<Item = &'a Vec3>) -> Self {
+        Document {
+            encoding,
+            grid: (encoding != Encoding::Plain).then(|| Grid::covering(points)),
+            ..Document::default()
+        }
+    }
+
+    /// Gives `node` the translation and uniform scale that map the
+    /// quantized positions back (nothing for plain data).
+    pub(super) fn place_node(&self, node: &mut Value) {
+        if let Some(grid) = &self.grid {
+            node["translation"] = json!(grid.origin.to_array());
+            node["scale"] = json!([grid.step, grid.step, grid.step]);
+        }
+    }
+
     /// The triangle-list primitive of `mesh` (indices and every attribute
     /// it has; no material), its data appended to the buffer. `path` names
     /// the output in errors.
@@ -128,6 +188,9 @@ impl Document {
             "glTF writer: {:?}",
             mesh.validate()
         );
+        if let Some(grid) = self.grid {
+            return Ok(self.quantized_primitive(mesh, &grid));
+        }
         let properties = &mesh.properties;
         let corners = mesh.triangles.iter().flatten();
         let (bytes, component) = if mesh.positions.len() > 65535 {
@@ -195,6 +258,169 @@ impl Document {
         Ok(json!({ "attributes": attributes, "indices": indices, "mode": TRIANGLES }))
     }
 
+    /// [`Document::primitive`] quantized, and compressed when the encoding
+    /// says so (the layout of [`super::gltf_compress`]).
+    fn quantized_primitive(&mut self, mesh: &Mesh, grid: &Grid) -> Value {
+        let n = mesh.positions.len();
+        let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+        let (component, size) = if n > 65535 {
+            (UNSIGNED_INT, 4)
+        } else {
+            (UNSIGNED_SHORT, 2)
+        };
+        let bytes: Vec<u8> = if size == 4 {
+            indices.iter().flat_map(|i| i.to_le_bytes()).collect()
+        } else {
+            indices
+                .iter()
+                .flat_map(|&i| (i as u16).to_le_bytes())
+                .collect()
+        };
+        let view = match self.encoding {
+            Encoding::Compressed => {
+                let coded = gltf_compress::encode_triangles(&indices, n);
+                self.compressed_view(
+                    &coded,
+                    &bytes,
+                    size,
+                    "TRIANGLES",
+                    None,
+                    ELEMENT_ARRAY_BUFFER,
+                )
+            }
+            _ => self.view(&bytes, Some(ELEMENT_ARRAY_BUFFER)),
+        };
+        let indices = self.push_accessor(view, component, false, "SCALAR", indices.len());
+        let mut attributes = serde_json::Map::new();
+        let (bytes, lo, hi) = gltf_compress::positions(&mesh.positions, grid);
+        let position = self.attribute(&bytes, 8, None, UNSIGNED_SHORT, false, "VEC3", n);
+        self.accessors[position]["min"] = json!(lo);
+        self.accessors[position]["max"] = json!(hi);
+        attributes.insert("POSITION".into(), json!(position));
+        let properties = &mesh.properties;
+        if let Some(normals) = &properties.normals {
+            let filled;
+            let normals = if normals.contains(&Vec3::ZERO) {
+                filled = fill_zero_normals(mesh, normals);
+                &filled
+            } else {
+                normals
+            };
+            let a = if self.encoding == Encoding::Compressed {
+                let bytes = gltf_compress::normals(normals);
+                self.attribute(&bytes, 4, Some("OCTAHEDRAL"), BYTE, true, "VEC3", n)
+            } else {
+                let bytes: Vec<u8> = normals
+                    .iter()
+                    .flat_map(|v| {
+                        let q = (v.normalize_or(Vec3::Z) * 127.0).round();
+                        [q.x as i8 as u8, q.y as i8 as u8, q.z as i8 as u8, 0]
+                    })
+                    .collect();
+                self.attribute(&bytes, 4, None, BYTE, true, "VEC3", n)
+            };
+            attributes.insert("NORMAL".into(), json!(a));
+        }
+        if let Some(uvs) = &properties.uvs {
+            let flipped: Vec<Vec2> = uvs.iter().map(|t| Vec2::new(t.x, 1.0 - t.y)).collect();
+            let (bytes, unit) = gltf_compress::uvs(&flipped);
+            let a = if unit {
+                self.attribute(&bytes, 4, None, UNSIGNED_SHORT, true, "VEC2", n)
+            } else {
+                self.attribute(&bytes, 8, None, FLOAT, false, "VEC2", n)
+            };
+            attributes.insert("TEXCOORD_0".into(), json!(a));
+        }
+        if let Some(colors) = &properties.colors {
+            let bytes = gltf_compress::colors(colors);
+            let a = self.attribute(&bytes, 4, None, UNSIGNED_BYTE, true, "VEC4", n);
+            attributes.insert("COLOR_0".into(), json!(a));
+        }
+        json!({ "attributes": attributes, "indices": indices, "mode": TRIANGLES })
+    }
+
+    /// A vertex attribute of `count` elements every `stride` bytes in
+    /// `bytes`, compressed (with `filter`) when the encoding says so; the
+    /// accessor's index.
+    #[allow(clippy::too_many_arguments)]
+    fn attribute(
+        &mut self,
+        bytes: &[u8],
+        stride: usize,
+        filter: Option<&str>,
+        component: u32,
+        normalized: bool,
+        ty: &str,
+        count: usize,
+    ) -> usize {
+        let view = if self.encoding == Encoding::Compressed {
+            let coded = gltf_compress::encode_attributes(bytes, stride);
+            self.compressed_view(&coded, bytes, stride, "ATTRIBUTES", filter, ARRAY_BUFFER)
+        } else {
+            self.view(bytes, Some(ARRAY_BUFFER))
+        };
+        self.views[view]["byteStride"] = json!(stride);
+        self.push_accessor(view, component, normalized, ty, count)
+    }
+
+    /// A view of `plain` (elements of `stride` bytes) whose data are
+    /// `coded` in buffer 0, decoding into the fallback buffer 1; its index.
+    fn compressed_view(
+        &mut self,
+        coded: &[u8],
+        plain: &[u8],
+        stride: usize,
+        mode: &str,
+        filter: Option<&str>,
+        target: u32,
+    ) -> usize {
+        self.bin.resize(self.bin.len().next_multiple_of(4), 0);
+        self.fallback = self.fallback.next_multiple_of(4);
+        let mut extension = json!({
+            "buffer": 0,
+            "byteOffset": self.bin.len(),
+            "byteLength": coded.len(),
+            "byteStride": stride,
+            "mode": mode,
+            "count": plain.len() / stride,
+        });
+        if let Some(filter) = filter {
+            extension["filter"] = json!(filter);
+        }
+        self.bin.extend_from_slice(coded);
+        self.views.push(json!({
+            "buffer": 1,
+            "byteOffset": self.fallback,
+            "byteLength": plain.len(),
+            "target": target,
+            "extensions": { "EXT_meshopt_compression": extension },
+        }));
+        self.fallback += plain.len();
+        self.views.len() - 1
+    }
+
+    /// An accessor over view `view`; its index.
+    fn push_accessor(
+        &mut self,
+        view: usize,
+        component: u32,
+        normalized: bool,
+        ty: &str,
+        count: usize,
+    ) -> usize {
+        let mut accessor = json!({
+            "bufferView": view,
+            "componentType": component,
+            "type": ty,
+            "count": count,
+        });
+        if normalized {
+            accessor["normalized"] = json!(true);
+        }
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
     /// Puts material 0 into `root`: base-colour texture 0 sampling image 0,
     /// `texture` (embedded in the buffer, or for a file beside a `.gltf` a
     /// relative URI; see the module docs).
@@ -242,6 +468,28 @@ impl Document {
             buffer["uri"] = json!(encode_uri_segment(name));
         }
         root["buffers"] = json!([buffer]);
+        let mut extensions = Vec::new();
+        if self.encoding != Encoding::Plain {
+            extensions.push("KHR_mesh_quantization");
+        }
+        if self.encoding == Encoding::Compressed {
+            extensions.push("EXT_meshopt_compression");
+            root["buffers"]
+                .as_array_mut()
+                .expect("an array")
+                .push(json!({
+                    "byteLength": self.fallback,
+                    "extensions": { "EXT_meshopt_compression": { "fallback": true } },
+                }));
+        }
+        for list in ["extensionsUsed", "extensionsRequired"] {
+            for name in &extensions {
+                match root.get_mut(list).and_then(Value::as_array_mut) {
+                    Some(names) => names.push(json!(name)),
+                    None => root[list] = json!([name]),
+                }
+            }
+        }
         root["bufferViews"] = Value::Array(self.views);
         root["accessors"] = Value::Array(self.accessors);
 
@@ -298,13 +546,7 @@ impl Document {
         count: usize,
     ) -> usize {
         let view = self.view(&data, Some(target));
-        self.accessors.push(json!({
-            "bufferView": view,
-            "componentType": component,
-            "type": ty,
-            "count": count,
-        }));
-        self.accessors.len() - 1
+        self.push_accessor(view, component, false, ty, count)
     }
 
     /// The image object for `texture`: a buffer view of its bytes, or (for

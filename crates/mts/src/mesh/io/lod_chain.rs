@@ -159,7 +159,10 @@ pub fn chain_from_collapses(
 /// `extensionsUsed` lists `MSFT_lod`, `extensionsRequired` does not. A
 /// chain of one level is a plain glTF file without the extension. Levels
 /// with a texture share material 0 and its image (embedded in a `.glb`;
-/// see `save_gltf` for how a `.gltf` refers to it).
+/// see `save_gltf` for how a `.gltf` refers to it). `encoding` stores the
+/// vertex data plain, quantized or compressed (`save_gltf_as`); quantized
+/// levels share one position grid (over every level's positions) and so
+/// one node transform.
 ///
 /// # Errors
 /// [`Error::InvalidArgument`] for no level, a level without triangles,
@@ -171,7 +174,12 @@ pub fn chain_from_collapses(
 /// Cost: the cache ordering of every level, then O(vertices + triangles)
 /// of all levels; the file is built in memory.
 #[cfg(feature = "gltf")]
-pub fn save_lod_chain(levels: &[ChainLevel], coverage: &Coverage, path: &Path) -> Result<()> {
+pub fn save_lod_chain(
+    levels: &[ChainLevel],
+    coverage: &Coverage,
+    path: &Path,
+    encoding: super::Encoding,
+) -> Result<()> {
     let binary = super::gltf_write::is_binary(path)?;
     let refuse = |message: String| Error::InvalidArgument(format!("{}: {message}", path.display()));
     let Some(first) = levels.first() else {
@@ -203,7 +211,8 @@ pub fn save_lod_chain(levels: &[ChainLevel], coverage: &Coverage, path: &Path) -
             )));
         }
     }
-    let mut out = super::gltf_write::Document::default();
+    let points = levels.iter().flat_map(|l| &l.mesh.positions);
+    let mut out = super::gltf_write::Document::new(encoding, points);
     let mut root = json!({
         "asset": { "version": "2.0", "generator": "mts" },
         "scene": 0,
@@ -226,7 +235,9 @@ pub fn save_lod_chain(levels: &[ChainLevel], coverage: &Coverage, path: &Path) -
             primitive["material"] = json!(0);
         }
         meshes.push(json!({ "name": format!("LOD{k}"), "primitives": [primitive] }));
-        nodes.push(json!({ "name": format!("LOD{k}"), "mesh": k }));
+        let mut node = json!({ "name": format!("LOD{k}"), "mesh": k });
+        out.place_node(&mut node);
+        nodes.push(node);
     }
     if levels.len() > 1 {
         let errors: Vec<f32> = levels.iter().map(|l| l.error).collect();

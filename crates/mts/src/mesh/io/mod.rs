@@ -14,6 +14,10 @@
 #[cfg(feature = "gltf")]
 mod gltf;
 #[cfg(feature = "gltf")]
+mod gltf_compress;
+#[cfg(feature = "gltf")]
+mod gltf_meshopt;
+#[cfg(feature = "gltf")]
 mod gltf_write;
 mod lod_chain;
 mod obj;
@@ -22,7 +26,9 @@ mod ply;
 #[cfg(feature = "gltf")]
 pub use gltf::{gltf_part_count, parse_gltf, parse_gltf_parts, parse_gltf_with, GltfPart};
 #[cfg(feature = "gltf")]
-pub use gltf_write::save_gltf;
+pub use gltf_compress::Grid;
+#[cfg(feature = "gltf")]
+pub use gltf_write::{save_gltf, save_gltf_as, Encoding};
 #[cfg(feature = "gltf")]
 pub use lod_chain::save_lod_chain;
 pub use lod_chain::{
