@@ -444,3 +444,62 @@ fn lods_writes_a_chain_that_reads_back() {
     assert!(!ok && err.contains("outside 0..=1"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--compress` writes glTF that the reader takes back with the same
+/// triangles, smaller than `--quantize`, itself smaller than plain; on
+/// every command that writes glTF; refused for another format.
+#[test]
+fn compress_writes_meshopt_gltf_that_reads_back() {
+    let dir = std::env::temp_dir().join(format!("mts-cli-compress-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let src = ["--generated", "torus:5k", "--properties"];
+    let mut sizes = Vec::new();
+    for (name, flag) in [
+        ("p.glb", None),
+        ("q.glb", Some("--quantize")),
+        ("c.glb", Some("--compress")),
+    ] {
+        let out = path(name);
+        let args: Vec<&str> = [&["convert"][..], &src, &["-o", &out]]
+            .concat()
+            .into_iter()
+            .chain(flag)
+            .collect();
+        let (ok, _, err) = mts(&args);
+        assert!(ok, "{err}");
+        sizes.push(std::fs::metadata(&out).unwrap().len());
+        let (ok, text, err) = mts(&["strips", &out, "--repeat", "1", "--json"]);
+        assert!(ok, "{err}");
+        assert_eq!(json(&text)["triangles"].as_u64(), Some(4900), "{name}");
+    }
+    assert!(sizes[2] < sizes[1] && sizes[1] < sizes[0], "{sizes:?}");
+    // The other writers of glTF.
+    let level = path("level.gltf");
+    let (ok, text, err) = mts(&[
+        &["simplify"][..],
+        &src,
+        &["--ratio", "0.5", "-o", &level, "--compress", "--json"],
+    ]
+    .concat());
+    assert!(ok, "{err}");
+    let kept = json(&text)["triangles"].as_u64().unwrap();
+    let (ok, text, err) = mts(&["strips", &level, "--repeat", "1", "--json"]);
+    assert!(ok, "{err}");
+    assert_eq!(json(&text)["triangles"].as_u64(), Some(kept));
+    let chain = path("chain.glb");
+    let (ok, _, err) = mts(&[&["lods"][..], &src, &["-o", &chain, "--compress"]].concat());
+    assert!(ok, "{err}");
+    let (ok, text, err) = mts(&["strips", &chain, "--repeat", "1", "--json"]);
+    assert!(ok, "{err}");
+    assert_eq!(json(&text)["triangles"].as_u64(), Some(4900));
+    // Only glTF is compressed.
+    let obj = path("c.obj");
+    let (ok, _, err) = mts(&[&["convert"][..], &src, &["-o", &obj, "--compress"]].concat());
+    assert!(
+        !ok && err.contains("name the output .glb or .gltf"),
+        "{err}"
+    );
+    assert!(!std::path::Path::new(&obj).exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

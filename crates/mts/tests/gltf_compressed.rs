@@ -35,8 +35,9 @@ fn canonical(t: [u32; 3]) -> [u32; 3] {
 
 /// `raw` is `mesh` within the quantization of `encoding`: the same
 /// triangles (up to rotation, when compressed), positions within half a
-/// grid step, normals within 2°, texture coordinates within 1/65,535 and
-/// colours within half of 1/255.
+/// grid step, normals within 2°, texture coordinates within half of their
+/// 12-bit step (4/32,767) and colours within half of 1/255. (The torus
+/// has no two vertices stored alike, so the writer merges none.)
 fn assert_within_steps(raw: &RawMesh, mesh: &Mesh, encoding: Encoding) {
     let ours: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
     let theirs: Vec<[u32; 3]> = raw.triangles.iter().map(|&t| canonical(t)).collect();
@@ -59,7 +60,7 @@ fn assert_within_steps(raw: &RawMesh, mesh: &Mesh, encoding: Encoding) {
     }
     for (a, b) in p.uvs.as_ref().unwrap().iter().zip(q.uvs.as_ref().unwrap()) {
         assert!(
-            (*a - *b).abs().max_element() <= 0.5 / 65535.0 + 1e-6,
+            (*a - *b).abs().max_element() <= 4.0 / 32767.0 + 1e-6,
             "{a} {b}"
         );
     }

@@ -7,17 +7,21 @@
 //! |---|---|---|---|
 //! | `POSITION` | u16 × 3 (+2 pad), 14 bits on a grid shared by the three axes; the node's `translation` and uniform `scale` map it back | none | ≤ half a grid step: extent / 32,766 |
 //! | `NORMAL` | i8 × 3 (+1), normalized, octahedral | `OCTAHEDRAL`, 8 bits | about 1° |
-//! | `TEXCOORD_0` | u16 × 2 normalized when every coordinate is in `[0, 1]`, else f32 | none | 1 / 131,070 |
+//! | `TEXCOORD_0` | i16 × 2 normalized on a 12-bit grid when every coordinate is in `[-1, 1]`, else f32 | none | 4 / 32,767 (about 1/8,192) |
 //! | `COLOR_0` | u8 × 4 normalized | none | 1 / 510 |
 //! | indices | u16 or u32 | `TRIANGLES` codec | exact |
 //!
-//! Why these: they are gltfpack's defaults (`-vp 14 -vn 8 -vc 8`), so its
-//! `-cc` output of the same level is the fair size to compare with; the
-//! texture coordinates keep 16 bits instead of gltfpack's 12 because
-//! gltfpack's range remap needs a `KHR_texture_transform` on a texture
-//! this writer may not have (coordinates without a texture are kept too),
-//! and 16 bits over `[0, 1]` needs none. One grid for the three axes keeps
-//! the node's scale uniform, so normals need no correction.
+//! Why these: they are gltfpack's defaults (`-vp 14 -vt 12 -vn 8 -vc 8`),
+//! so its `-cc` output of the same level is the fair size to compare with.
+//! gltfpack maps texture coordinates' own range onto its 12 bits and
+//! places them back with a `KHR_texture_transform` on the material's
+//! texture; without a texture (coordinates a file carries for later) it
+//! has nowhere to put that transform and writes integers no reader can
+//! place. This writer keeps 12 bits of a fixed range, `[-1, 1]` as a
+//! normalized short, which needs no transform, and floats beyond it. One
+//! grid for the three axes keeps the node's scale uniform, so normals need
+//! no correction. Vertices whose stored attributes are identical are
+//! merged ([`quantize`]).
 //!
 //! The codecs: attributes in version 0 of the vertex codec (the one
 //! `EXT_meshopt_compression` specifies; version 1 is only for the
@@ -26,7 +30,123 @@
 //! first use ([`super::order_for_cache`]) for the codecs to do well; the
 //! callers write levels in that order.
 
+use crate::mesh::Mesh;
 use glam::{Vec2, Vec3, Vec4};
+use std::collections::HashMap;
+
+/// A level's vertex streams as stored, and its triangles: what
+/// [`quantize`] gives the writer.
+pub(super) struct Quantized {
+    pub triangles: Vec<[u32; 3]>,
+    pub vertex_count: usize,
+    /// u16 × 4 per vertex, and the least and greatest coordinates.
+    pub positions: Vec<u8>,
+    pub lo: [u16; 3],
+    pub hi: [u16; 3],
+    /// i8 × 4 per vertex: octahedral (for the filter) or plain xyz.
+    pub normals: Option<Vec<u8>>,
+    /// Per vertex: i16 × 2 normalized (`true`) or f32 × 2.
+    pub uvs: Option<(Vec<u8>, bool)>,
+    /// u8 × 4 per vertex.
+    pub colors: Option<Vec<u8>>,
+}
+
+/// Quantizes `mesh` (whose zero normals, if any, are already filled, in
+/// `normals`) on `grid`, normals octahedral when `octahedral`, then
+/// merges the vertices whose stored bytes are identical in every stream
+/// and renumbers them in order of first use. A glTF vertex is its stored
+/// attributes: two vertices that quantize alike draw alike (mts keeps
+/// bit-identical duplicates apart, its vertices being the input file's;
+/// gltfpack merges them too, so sizes compare the same vertices).
+///
+/// Cost: O(V + T), one hash map of V entries.
+pub(super) fn quantize(
+    mesh: &Mesh,
+    normals: Option<&[Vec3]>,
+    grid: &Grid,
+    octahedral: bool,
+) -> Quantized {
+    let p = &mesh.properties;
+    let all_positions = positions(&mesh.positions, grid).0;
+    let all_normals = normals.map(|n| {
+        if octahedral {
+            octahedral_normals(n)
+        } else {
+            plain_normals(n)
+        }
+    });
+    let all_uvs = p.uvs.as_ref().map(|t| {
+        let flipped: Vec<Vec2> = t.iter().map(|t| Vec2::new(t.x, 1.0 - t.y)).collect();
+        uvs(&flipped)
+    });
+    let all_colors = p.colors.as_ref().map(|c| colors(c));
+    let uv_size = all_uvs
+        .as_ref()
+        .map_or(0, |(_, unit)| if *unit { 4 } else { 8 });
+    let record = |v: usize| -> Vec<u8> {
+        let mut key = all_positions[v * 8..v * 8 + 6].to_vec();
+        if let Some(n) = &all_normals {
+            key.extend_from_slice(&n[v * 4..v * 4 + 4]);
+        }
+        if let Some((t, _)) = &all_uvs {
+            key.extend_from_slice(&t[v * uv_size..(v + 1) * uv_size]);
+        }
+        if let Some(c) = &all_colors {
+            key.extend_from_slice(&c[v * 4..v * 4 + 4]);
+        }
+        key
+    };
+    let mut first: HashMap<Vec<u8>, u32> = HashMap::with_capacity(mesh.positions.len());
+    let same: Vec<u32> = (0..mesh.positions.len())
+        .map(|v| *first.entry(record(v)).or_insert(v as u32))
+        .collect();
+    // Renumber in order of first use (what the vertex codec and the GPU's
+    // vertex fetch do best with).
+    const UNUSED: u32 = u32::MAX;
+    let mut number = vec![UNUSED; mesh.positions.len()];
+    let mut order = Vec::new();
+    let triangles: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                let v = same[v as usize] as usize;
+                if number[v] == UNUSED {
+                    number[v] = order.len() as u32;
+                    order.push(v);
+                }
+                number[v]
+            })
+        })
+        .collect();
+    let gather = |bytes: &[u8], size: usize| -> Vec<u8> {
+        order
+            .iter()
+            .flat_map(|&v| &bytes[v * size..(v + 1) * size])
+            .copied()
+            .collect()
+    };
+    let positions = gather(&all_positions, 8);
+    let mut lo = [u16::MAX; 3];
+    let mut hi = [0u16; 3];
+    for q in positions.chunks_exact(8) {
+        for k in 0..3 {
+            let x = u16::from_le_bytes([q[2 * k], q[2 * k + 1]]);
+            lo[k] = lo[k].min(x);
+            hi[k] = hi[k].max(x);
+        }
+    }
+    Quantized {
+        vertex_count: order.len(),
+        triangles,
+        positions,
+        lo,
+        hi,
+        normals: all_normals.map(|n| gather(&n, 4)),
+        uvs: all_uvs.map(|(t, unit)| (gather(&t, uv_size), unit)),
+        colors: all_colors.map(|c| gather(&c, 4)),
+    }
+}
 
 /// The quantization grid of positions: `origin + q × step` for `q` in
 /// `0..=16383` on each axis.
@@ -76,7 +196,7 @@ impl Grid {
 
 /// Positions as u16 × 4 (the fourth 0): 8 bytes each, and the least and
 /// greatest quantized coordinates (the accessor's `min` and `max`).
-pub(super) fn positions(points: &[Vec3], grid: &Grid) -> (Vec<u8>, [u16; 3], [u16; 3]) {
+fn positions(points: &[Vec3], grid: &Grid) -> (Vec<u8>, [u16; 3], [u16; 3]) {
     let mut lo = [u16::MAX; 3];
     let mut hi = [0u16; 3];
     let mut out = Vec::with_capacity(points.len() * 8);
@@ -92,9 +212,20 @@ pub(super) fn positions(points: &[Vec3], grid: &Grid) -> (Vec<u8>, [u16; 3], [u1
     (out, lo, hi)
 }
 
+/// Unit normals as normalized i8 × 3 (and a zero byte).
+fn plain_normals(normals: &[Vec3]) -> Vec<u8> {
+    normals
+        .iter()
+        .flat_map(|v| {
+            let q = (v.normalize_or(Vec3::Z) * 127.0).round();
+            [q.x as i8 as u8, q.y as i8 as u8, q.z as i8 as u8, 0]
+        })
+        .collect()
+}
+
 /// Unit normals in the octahedral filter's 8-bit form (i8 × 4): what
 /// `meshopt_decodeFilterOct` turns back into normalized i8 × 3.
-pub(super) fn normals(normals: &[Vec3]) -> Vec<u8> {
+fn octahedral_normals(normals: &[Vec3]) -> Vec<u8> {
     let data: Vec<[f32; 4]> = normals
         .iter()
         .map(|n| {
@@ -106,18 +237,25 @@ pub(super) fn normals(normals: &[Vec3]) -> Vec<u8> {
     coded.iter().flat_map(|c| c.map(|x| x as u8)).collect()
 }
 
-/// Texture coordinates (already in glTF's `v`-down convention): u16 × 2
-/// normalized when all lie in `[0, 1]`, with `true`; else f32 × 2 and
-/// `false`.
-pub(super) fn uvs(uvs: &[Vec2]) -> (Vec<u8>, bool) {
-    let unit = uvs
-        .iter()
-        .all(|t| (0.0..=1.0).contains(&t.x) && (0.0..=1.0).contains(&t.y));
+/// The grid of texture coordinates: 12 bits per unit (gltfpack's default
+/// `-vt 12`), stored as multiples of 8 of a normalized i16.
+const UV_STEP: f32 = 8.0;
+
+/// Texture coordinates (already in glTF's `v`-down convention): normalized
+/// i16 × 2 on a 12-bit grid when every coordinate lies in `[-1, 1]`
+/// (`KHR_mesh_quantization` allows signed shorts), with `true`; else f32
+/// × 2 and `false`. The grid's step is 8 / 32,767 (about 1/4,096: half a
+/// texel of a 4,096-wide image at most off).
+fn uvs(uvs: &[Vec2]) -> (Vec<u8>, bool) {
+    let unit = uvs.iter().all(|t| t.x.abs() <= 1.0 && t.y.abs() <= 1.0);
     if unit {
         let bytes = uvs
             .iter()
             .flat_map(|t| [t.x, t.y])
-            .flat_map(|x| ((x * 65535.0).round() as u16).to_le_bytes())
+            .flat_map(|x| {
+                let q = (x * 32767.0 / UV_STEP).round() * UV_STEP;
+                (q.clamp(-32767.0, 32767.0) as i16).to_le_bytes()
+            })
             .collect();
         (bytes, true)
     } else {
@@ -131,7 +269,7 @@ pub(super) fn uvs(uvs: &[Vec2]) -> (Vec<u8>, bool) {
 }
 
 /// Colours as u8 × 4 normalized.
-pub(super) fn colors(colors: &[Vec4]) -> Vec<u8> {
+fn colors(colors: &[Vec4]) -> Vec<u8> {
     colors
         .iter()
         .flat_map(|c| c.to_array())
@@ -205,10 +343,34 @@ mod tests {
     }
 
     #[test]
+    fn vertices_stored_alike_are_merged_and_different_ones_kept() {
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X, Vec3::ONE];
+        let mut mesh = Mesh {
+            positions,
+            triangles: vec![[0, 1, 2], [3, 4, 2]],
+            properties: Default::default(),
+        };
+        let grid = Grid::covering(&mesh.positions);
+        let q = quantize(&mesh, None, &grid, true);
+        assert_eq!(q.vertex_count, 4);
+        assert_eq!(q.triangles, [[0, 1, 2], [1, 3, 2]]);
+        assert_eq!(q.positions.len(), 32);
+        assert_eq!((q.lo, q.hi), ([0; 3], [16383; 3]));
+        // The same position with another normal stays two vertices.
+        let normals = [Vec3::Z, Vec3::Z, Vec3::Z, Vec3::X, Vec3::Z];
+        mesh.properties.normals = Some(normals.to_vec());
+        let q = quantize(&mesh, Some(&normals), &grid, true);
+        assert_eq!(q.vertex_count, 5);
+        assert_eq!(q.normals.unwrap().len(), 20);
+    }
+
+    #[test]
     fn texture_coordinates_outside_the_unit_square_stay_floats() {
-        // 0.5 is 32,767.5 steps, rounded to 32,768; 1.0 is 65,535.
-        assert_eq!(uvs(&[Vec2::new(0.5, 1.0)]).0, [0x00, 0x80, 0xff, 0xff]);
-        assert!(uvs(&[Vec2::new(0.5, 1.0)]).1);
+        // 0.5 is 16,383.5 / 8 steps of 8 (rounded to 2,048 × 8 = 16,384);
+        // -1.0 is -32,767 (clamped).
+        let (bytes, unit) = uvs(&[Vec2::new(0.5, -1.0)]);
+        assert!(unit);
+        assert_eq!(bytes, [0x00, 0x40, 0x01, 0x80]);
         let (bytes, unit) = uvs(&[Vec2::new(1.5, 0.0)]);
         assert!(!unit);
         assert_eq!(bytes.len(), 8);

@@ -36,7 +36,7 @@
 use super::gltf_compress::{self, Grid};
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, Texture};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -46,6 +46,7 @@ const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const FLOAT: u32 = 5126;
 const BYTE: u32 = 5120;
+const SHORT: u32 = 5122;
 const UNSIGNED_BYTE: u32 = 5121;
 const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
@@ -261,8 +262,18 @@ impl Document {
     /// [`Document::primitive`] quantized, and compressed when the encoding
     /// says so (the layout of [`super::gltf_compress`]).
     fn quantized_primitive(&mut self, mesh: &Mesh, grid: &Grid) -> Value {
-        let n = mesh.positions.len();
-        let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+        let compressed = self.encoding == Encoding::Compressed;
+        let filled;
+        let normals = match &mesh.properties.normals {
+            Some(n) if n.contains(&Vec3::ZERO) => {
+                filled = fill_zero_normals(mesh, n);
+                Some(&filled[..])
+            }
+            other => other.as_deref(),
+        };
+        let q = gltf_compress::quantize(mesh, normals, grid, compressed);
+        let n = q.vertex_count;
+        let indices: Vec<u32> = q.triangles.iter().flatten().copied().collect();
         let (component, size) = if n > 65535 {
             (UNSIGNED_INT, 4)
         } else {
@@ -276,64 +287,40 @@ impl Document {
                 .flat_map(|&i| (i as u16).to_le_bytes())
                 .collect()
         };
-        let view = match self.encoding {
-            Encoding::Compressed => {
-                let coded = gltf_compress::encode_triangles(&indices, n);
-                self.compressed_view(
-                    &coded,
-                    &bytes,
-                    size,
-                    "TRIANGLES",
-                    None,
-                    ELEMENT_ARRAY_BUFFER,
-                )
-            }
-            _ => self.view(&bytes, Some(ELEMENT_ARRAY_BUFFER)),
+        let view = if compressed {
+            let coded = gltf_compress::encode_triangles(&indices, n);
+            self.compressed_view(
+                &coded,
+                &bytes,
+                size,
+                "TRIANGLES",
+                None,
+                ELEMENT_ARRAY_BUFFER,
+            )
+        } else {
+            self.view(&bytes, Some(ELEMENT_ARRAY_BUFFER))
         };
         let indices = self.push_accessor(view, component, false, "SCALAR", indices.len());
         let mut attributes = serde_json::Map::new();
-        let (bytes, lo, hi) = gltf_compress::positions(&mesh.positions, grid);
-        let position = self.attribute(&bytes, 8, None, UNSIGNED_SHORT, false, "VEC3", n);
-        self.accessors[position]["min"] = json!(lo);
-        self.accessors[position]["max"] = json!(hi);
+        let position = self.attribute(&q.positions, 8, None, UNSIGNED_SHORT, false, "VEC3", n);
+        self.accessors[position]["min"] = json!(q.lo);
+        self.accessors[position]["max"] = json!(q.hi);
         attributes.insert("POSITION".into(), json!(position));
-        let properties = &mesh.properties;
-        if let Some(normals) = &properties.normals {
-            let filled;
-            let normals = if normals.contains(&Vec3::ZERO) {
-                filled = fill_zero_normals(mesh, normals);
-                &filled
-            } else {
-                normals
-            };
-            let a = if self.encoding == Encoding::Compressed {
-                let bytes = gltf_compress::normals(normals);
-                self.attribute(&bytes, 4, Some("OCTAHEDRAL"), BYTE, true, "VEC3", n)
-            } else {
-                let bytes: Vec<u8> = normals
-                    .iter()
-                    .flat_map(|v| {
-                        let q = (v.normalize_or(Vec3::Z) * 127.0).round();
-                        [q.x as i8 as u8, q.y as i8 as u8, q.z as i8 as u8, 0]
-                    })
-                    .collect();
-                self.attribute(&bytes, 4, None, BYTE, true, "VEC3", n)
-            };
+        if let Some(bytes) = &q.normals {
+            let filter = compressed.then_some("OCTAHEDRAL");
+            let a = self.attribute(bytes, 4, filter, BYTE, true, "VEC3", n);
             attributes.insert("NORMAL".into(), json!(a));
         }
-        if let Some(uvs) = &properties.uvs {
-            let flipped: Vec<Vec2> = uvs.iter().map(|t| Vec2::new(t.x, 1.0 - t.y)).collect();
-            let (bytes, unit) = gltf_compress::uvs(&flipped);
-            let a = if unit {
-                self.attribute(&bytes, 4, None, UNSIGNED_SHORT, true, "VEC2", n)
+        if let Some((bytes, unit)) = &q.uvs {
+            let a = if *unit {
+                self.attribute(bytes, 4, None, SHORT, true, "VEC2", n)
             } else {
-                self.attribute(&bytes, 8, None, FLOAT, false, "VEC2", n)
+                self.attribute(bytes, 8, None, FLOAT, false, "VEC2", n)
             };
             attributes.insert("TEXCOORD_0".into(), json!(a));
         }
-        if let Some(colors) = &properties.colors {
-            let bytes = gltf_compress::colors(colors);
-            let a = self.attribute(&bytes, 4, None, UNSIGNED_BYTE, true, "VEC4", n);
+        if let Some(bytes) = &q.colors {
+            let a = self.attribute(bytes, 4, None, UNSIGNED_BYTE, true, "VEC4", n);
             attributes.insert("COLOR_0".into(), json!(a));
         }
         json!({ "attributes": attributes, "indices": indices, "mode": TRIANGLES })
