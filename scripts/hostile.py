@@ -11,9 +11,9 @@ CI slice (fixed seed 19, timeout 10 s): the issue-19 families' 600 inputs
 (about 1,700 runs; no heavy extreme mesh, no argument that is slow even
 when handled right, one render run), the same inputs as before issue 31,
 then a fixed slice of each issue-31 family (161 inputs, about 300 runs),
-of the issue-33 one, hier (24 inputs, 72 runs) and of the issue-34 one,
-coded (24 inputs, 72 runs: QUICK_SLICE); about a minute on 2 cores with a
-sound binary::
+of the issue-33 one, hier (24 inputs, 72 runs), of the issue-34 one,
+coded (24 inputs, 72 runs) and of the issue-35 one, meshopt (24 inputs, 48
+runs: QUICK_SLICE); about a minute on 2 cores with a sound binary::
 
     python3 scripts/hostile.py --mts target/release/mts --quick
 
@@ -26,11 +26,11 @@ each hang adds up to --timeout)::
 The issue-31 families alone (the figure in its closing note)::
 
     python3 scripts/hostile.py --mts target/release/mts \
-        --families gltf,amplify,fifo,output,view,props,reseal,hier,coded --count 600
+        --families gltf,amplify,fifo,output,view,props,reseal,hier,coded,meshopt --count 600
 
 Other options: --seed N, --count N (inputs), --timeout S (20), --mem-gb G (4),
 --families obj,ply,mts,stream,args,extreme,gltf,amplify,fifo,output,view,
-props,reseal,hier,coded, --jobs N (2), --list-limit N. The same seed, count and
+props,reseal,hier,coded,meshopt, --jobs N (2), --list-limit N. The same seed, count and
 --families give the same inputs whatever --jobs says (each input is drawn
 from its own generator, seeded by seed and index). With --quick, --families
 picks among the slices (the issue-19 ones share 600 inputs as before).
@@ -203,6 +203,42 @@ coded    version-5 files (`mts build`'s default: a torus, an
          or not), the section count, trailing bytes. All refused by
          `verify`, `info` and `extract` but a flip in a frame, which
          `verify` decides.
+meshopt  glTF whose buffer views are compressed with EXT_meshopt_compression
+         (`mts convert --compress`: a torus with properties, one without,
+         one of 140k triangles with 32-bit indices; MeshoptDoc) or
+         KHR_meshopt_compression, read by `convert -o x.obj` and one of
+         convert to .ply, strips, build, encode (not build or encode on the
+         140k seed). Accepted and read right (the triangles of the seed's
+         `--quantize` twin): the seed as written (.glb, and .gltf + .bin),
+         rewritten with input.bin or a data URI, with KHR_ for EXT_, integers
+         written as floats (8.0), a good KHR_ object beside a bogus EXT_ one
+         (KHR_ wins), two streams of one layout swapped, a hand-made stream
+         of zeros (version 0, or version 1 under KHR_: 64 x and 1024 x; up
+         to 4 M elements) for a view whose zeros leave the mesh valid, the
+         compressed bytes in buffer 1 given data. Refused naming the view
+         ("bufferView N", MO_VIEW_RE): a count of 2^32 to 2^64-1 with the
+         view's byteLength made stride x count (where the rules let it
+         through, refused by the expansion bound or the limit as well:
+         MO_LIMIT_RE), zero streams announcing 2^26 or 2^28 elements, more
+         than --max-triangles allows, or 2^30 from 4,096 (these runs under
+         a 512 MB address-space cap and 5 s: MO_AMPLIFY); byteLength or
+         byteOffset past buffer 0; byteStride 0, 2, 3, 6, 10, 258, 260...
+         for attributes, 0, 1, 3, 6, 8, 16 for indices; unknown modes; a
+         stream decoded with another codec; filters the mode or stride
+         forbids, unknown ones, COLOR under EXT_; a TRIANGLES count not a
+         multiple of 3; the view's own byteLength not stride x count, or its
+         byteStride another; negative, fractional, string, null, boolean,
+         array, object, 1e300, 2^53 and 2^64 values, missing fields; a
+         missing buffer; an attribute stream one byte short or long; buffer
+         0 cut short. Refused naming the file: the views reading the
+         fallback (no data: the primitive skipped, no triangles left) or
+         zeros in it, a count below the accessor's, an extension name
+         misspelled in a view or in extensionsRequired. No verdict: byte
+         flips and splices in a stream, an index stream cut or extended, a
+         larger count, another allowed filter, random bytes in the
+         fallback, a fallback uri that cannot be read (missing, malformed, a
+         FIFO, a directory, /dev/zero: never loaded, never a hang), the
+         views under one name and extensionsUsed under the other.
 
 Checksums (read from src/model/format.rs and src/baselines/cluster/stream.rs):
 .mts: header "MTSMODEL" | version u32 | section count u32 | file length u64
@@ -222,7 +258,8 @@ hang              the time limit (--timeout) was reached; the whole process
                   group is killed.
 oom               "memory allocation of", "capacity overflow", "out of
                   memory", "Cannot allocate memory" in stderr, or killed by
-                  SIGKILL (the address-space cap, RLIMIT_AS = --mem-gb).
+                  SIGKILL (the address-space cap, RLIMIT_AS = --mem-gb, or
+                  a run's own lower one: meshopt's MO_AMPLIFY).
 panic             "panicked at" / "has overflowed its stack" in stderr, or
                   death by any other signal (SIGABRT, SIGSEGV, ...).
 garbage accepted  exit 0 on an input the CLI must refuse (truncated .mts,
@@ -280,19 +317,20 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 
-# The issue-19 families, then the issue-31 ones (and issue 33's hier).
+# The issue-19 families, then the issue-31 ones (and issue 33's hier, issue
+# 34's coded, issue 35's meshopt).
 OLD_FAMILIES = ["obj", "ply", "mts", "stream", "args", "extreme"]
-NEW_FAMILIES = ["gltf", "amplify", "fifo", "output", "view", "props", "reseal", "hier", "coded"]
+NEW_FAMILIES = ["gltf", "amplify", "fifo", "output", "view", "props", "reseal", "hier", "coded", "meshopt"]
 FAMILIES = OLD_FAMILIES + NEW_FAMILIES
 # Share of the inputs per family.
 WEIGHTS = {"obj": 26, "ply": 25, "mts": 19, "stream": 15, "extreme": 9, "args": 6,
            "gltf": 14, "amplify": 1, "fifo": 2, "output": 6, "view": 2, "props": 3, "reseal": 9, "hier": 6,
-           "coded": 6}
+           "coded": 6, "meshopt": 6}
 DEFAULT_COUNT = 3700
 QUICK_COUNT = 600  # the issue-19 families' share of --quick
 # --quick: a fixed slice of each issue-31 family, after those 600 inputs.
 QUICK_SLICE = {"gltf": 36, "amplify": 4, "fifo": 10, "output": 64, "view": 10, "props": 13, "reseal": 24,
-               "hier": 24, "coded": 24}
+               "hier": 24, "coded": 24, "meshopt": 24}
 QUICK_SEED = 19
 QUICK_TIMEOUT = 10
 
@@ -3907,6 +3945,585 @@ def gen_coded(rng, seeds, index, quick=False):
     return case
 
 
+# --- glTF compressed with EXT_/KHR_meshopt_compression (issue 35) -------------
+
+MO_EXT, MO_KHR = "EXT_meshopt_compression", "KHR_meshopt_compression"
+MO_MODES = ("ATTRIBUTES", "TRIANGLES", "INDICES")
+# A refusal of a compressed view names it: "bufferView 3" (the extension's
+# rules, the stream's range, the decoder) or "buffer view 3" (an accessor
+# running past the view as decoded).
+MO_VIEW_RE = r"(?i)\bbuffer ?view \d+"
+# ... and, for a count or a stream asking for more than any valid one, the
+# limit or bound it passes.
+MO_LIMIT_RE = r"(?is)(?=.*\bbuffer ?view \d+)(?=.*(?:limit|at most|the most|more than|too many|exceed))"
+# Runs that ask for much more than the file holds (a count of 2^40, a
+# stream of zeros announcing 2^28 elements) get a lower address-space cap
+# and time limit: a reader that allocates what they announce fails
+# ("oom"), one that decodes it "hangs".
+MO_AMPLIFY = dict(mem=512 << 20, timeout=5)
+
+
+class MeshoptDoc:
+    """A glTF document written by `mts convert --compress` (a .glb: the BIN
+    chunk, buffer 0, holds the compressed streams; buffer 1 is the fallback,
+    without data, that the views' own buffer/byteOffset/byteLength name; each
+    view's extension object gives buffer, byteOffset, byteLength,
+    byteStride, count, mode, filter), taken apart to be edited and written
+    in any style (glb, a .gltf with input.bin, a data URI)."""
+
+    def __init__(self, data):
+        if data[:4] != b"glTF" or struct.unpack_from("<I", data, 4)[0] != 2:
+            raise ValueError("not a version-2 GLB")
+        n, kind = struct.unpack_from("<I4s", data, 12)
+        if kind != b"JSON":
+            raise ValueError("its first chunk is not JSON")
+        self.j = json.loads(data[20 : 20 + n].decode(), object_pairs_hook=collections.OrderedDict)
+        m, kind = struct.unpack_from("<I4s", data, 20 + n)
+        if kind != b"BIN\0":
+            raise ValueError("its second chunk is not BIN")
+        self.bin = bytearray(data[28 + n : 28 + n + m])
+        self.name = MO_EXT
+        buffers = self.j.get("buffers", [])
+        if len(buffers) != 2 or "uri" in buffers[0] or "uri" in buffers[1]:
+            raise ValueError("buffers %s, not the BIN chunk and a fallback without uri" % buffers)
+        if not self.views() or buffers[0]["byteLength"] > len(self.bin):
+            raise ValueError("no compressed view, or buffer 0 longer than the BIN chunk")
+        for v, view, e in self.views():
+            if (e.get("buffer") != 0 or view.get("buffer") != 1 or e.get("mode") not in MO_MODES
+                    or e.get("byteOffset", 0) + e["byteLength"] > buffers[0]["byteLength"]
+                    or view["byteLength"] != e["byteStride"] * e["count"]):
+                raise ValueError("bufferView %d: %s" % (v, json.dumps(view)))
+        if self.stream_end() != buffers[0]["byteLength"]:
+            raise ValueError("the last stream does not end buffer 0")
+
+    def views(self):
+        """(index, view, extension object) of every compressed view."""
+        return [(v, view, view["extensions"][self.name]) for v, view in enumerate(self.j["bufferViews"])
+                if self.name in view.get("extensions", {})]
+
+    def stream_end(self):
+        return max(e.get("byteOffset", 0) + e["byteLength"] for _, _, e in self.views())
+
+    def position_views(self):
+        acc = self.j["accessors"]
+        return {acc[p["attributes"]["POSITION"]].get("bufferView") for m in self.j["meshes"] for p in m["primitives"]
+                if "POSITION" in p["attributes"]}
+
+    def triangles(self):
+        return sum(e["count"] for _, _, e in self.views() if e["mode"] == "TRIANGLES") // 3
+
+    def rename(self, name):
+        """The extension called `name` everywhere: views, the fallback
+        buffer, extensionsUsed and extensionsRequired."""
+        self.j = json.loads(json.dumps(self.j).replace(self.name, name), object_pairs_hook=collections.OrderedDict)
+        self.name = name
+
+    def fit(self, v):
+        """View v's own byteLength made stride x count, and the fallback
+        long enough to hold it: only the edit under test breaks a rule."""
+        e = self.j["bufferViews"][v]["extensions"][self.name]
+        self.j["bufferViews"][v]["byteLength"] = min(e["byteStride"] * e["count"], 2 ** 64 - 1)
+        self.fit_fallback()
+
+    def fit_fallback(self):
+        fallback = self.j["buffers"][1]
+        ends = [view.get("byteOffset", 0) + view["byteLength"] for view in self.j["bufferViews"]
+                if view.get("buffer") == 1 and isinstance(view.get("byteLength"), int)]
+        fallback["byteLength"] = min(max([fallback["byteLength"]] + ends), 2 ** 64 - 1)
+
+    def append(self, stream):
+        """Appends a stream to buffer 0 (4-aligned): its byteOffset."""
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        at = len(self.bin)
+        self.bin += stream
+        self.j["buffers"][0]["byteLength"] = len(self.bin)
+        return at
+
+    def shift(self, after, by, keep):
+        """Moves every stream but view `keep`'s starting after byte `after`
+        by `by` bytes (a splice that inserts or deletes)."""
+        for v, _, e in self.views():
+            if v != keep and e.get("byteOffset", 0) > after:
+                e["byteOffset"] += by
+        self.j["buffers"][0]["byteLength"] += by
+
+    def write(self, style):
+        """(main file bytes, extension, {extra file: bytes})."""
+        b0 = self.j["buffers"][0]
+        b0.pop("uri", None)
+        if style == "external":
+            b0["uri"] = "input.bin"
+        elif style == "datauri":
+            import base64
+            b0["uri"] = "data:application/octet-stream;base64," + base64.b64encode(bytes(self.bin)).decode()
+        text = json.dumps(self.j).encode()
+        if style == "glb":
+            return glb_pack(text, bytes(self.bin)), ".glb", {}
+        return text, ".gltf", ({"input.bin": bytes(self.bin)} if style == "external" else {})
+
+
+def meshopt_zero_stream(count, stride, version):
+    """An attribute stream of `count` zero elements of `stride` bytes
+    (meshoptimizer's vertex codec, vertexcodec.cpp): header 0xa0 | version;
+    per block of min(8192 / stride rounded down to 16, 256) elements,
+    version 0 spends 2 header bits per byte channel and group of 16 (0:
+    zeros), version 1 one control byte per 4 channels (0xaa: zeros); the tail
+    (the baseline element, and version 1's channel modes) padded to 32 or 24
+    bytes. Version 0 expands 64 x, version 1 up to 1024 x."""
+    block = min((8192 // stride) & ~15, 256)
+    out = bytearray([0xA0 | version])
+    done = 0
+    while done < count:
+        size = min(block, count - done)
+        if version == 0:
+            out += bytes(stride * ((((size + 15) & ~15) // 16 + 3) // 4))
+        else:
+            out += b"\xaa" * (stride // 4)
+        done += size
+    tail = stride + (0 if version == 0 else stride // 4)
+    out += bytes(max(tail, 32 if version == 0 else 24))
+    return bytes(out)
+
+
+class MCase:
+    """What a meshopt generator returns: a label, the expectation, the
+    document (or raw bytes and files), the style, the message a refusal must
+    give, extra arguments and options (MO_AMPLIFY)."""
+
+    def __init__(self, label, expect, doc=None, style="glb", raw=None, ext=None, files=None, must=None, argv=(),
+                 amplify=False):
+        self.label, self.expect, self.doc, self.style = label, expect, doc, style
+        self.raw, self.ext, self.files, self.must = raw, ext, dict(files or {}), must
+        self.argv, self.amplify = list(argv), amplify
+
+
+def meshopt_case(rng, kind, seeds, name):
+    """One input of `kind` (MESHOPT_KINDS) from seed `name`, or None when the
+    seed has no view the kind needs."""
+    doc = MeshoptDoc(seeds.meshopt[name])
+    style = rng.choice(["glb", "glb", "external", "datauri"])
+    views = doc.views()
+    v, view, e = rng.choice(views)
+    attrs = [x for x in views if x[2]["mode"] == "ATTRIBUTES"]
+    tris = [x for x in views if x[2]["mode"] == "TRIANGLES"]
+    declared = doc.j["buffers"][0]["byteLength"]
+    off, length = e.get("byteOffset", 0), e["byteLength"]
+    tag = "%s/%s" % (name[:-4], style)
+
+    def at(what, expect, **kw):
+        return MCase("%s:%s/%s" % (kind, what, tag), expect, doc, style, **kw)
+
+    if kind == "clean":
+        return MCase("clean/%s" % name[:-4], ACCEPT, raw=seeds.meshopt[name], ext=".glb")
+    if kind == "gltf_written":
+        if name not in seeds.meshopt_gltf:
+            return None
+        text, bin_name, data = seeds.meshopt_gltf[name]
+        return MCase("gltf_written/%s" % name[:-4], ACCEPT, raw=text, ext=".gltf", files={bin_name: data})
+    if kind in ("khr", "restyled"):
+        if kind == "khr" or rng.random() < 0.5:
+            doc.rename(MO_KHR)
+        if kind == "restyled":
+            style = rng.choice(["external", "datauri"])
+            tag = "%s/%s" % (name[:-4], style)
+        return at(doc.name[:3], ACCEPT)
+    if kind == "int_float":
+        # Integers written as floats (8.0): glTF's JSON numbers, read so.
+        field = rng.choice(["buffer", "byteOffset", "byteLength", "byteStride", "count"])
+        e[field] = float(e.get(field, 0))
+        return at("view%d.%s" % (v, field), ACCEPT)
+    if kind == "both_names":
+        # The KHR_ object wins over EXT_ in one view: a bogus EXT_ one beside
+        # a good KHR_ one is read, the other way round refused.
+        bogus = dict(e)
+        bogus.update(rng.choice([{"buffer": 7}, {"byteStride": 6}, {"mode": "LINES"}, {"count": 2 ** 40},
+                                 {"filter": "LINEAR"}]))
+        khr_good = rng.random() < 0.6
+        view["extensions"][MO_KHR] = dict(e) if khr_good else bogus
+        if khr_good:
+            view["extensions"][MO_EXT] = bogus
+        for key in ("extensionsUsed", "extensionsRequired"):
+            doc.j[key].append(MO_KHR)
+        return at("view%d.%s" % (v, "khr_good" if khr_good else "khr_bogus"), ACCEPT if khr_good else GARBAGE,
+                  must=MO_VIEW_RE)
+    if kind == "stream_swap":
+        # Two streams' places swapped: attributes of one layout (texture
+        # coordinates and colours, 4 bytes, no filter) read each other's,
+        # valid; the triangles read an attribute stream, refused.
+        pos = doc.position_views()
+        plain = [x for x in attrs if x[0] not in pos and x[2].get("filter", "NONE") == "NONE"]
+        pairs = [(a, b) for a in plain for b in plain if a[0] < b[0] and a[2]["byteStride"] == b[2]["byteStride"]
+                 and a[2]["count"] == b[2]["count"]]
+        if pairs and rng.random() < 0.6:
+            (a, _, ea), (b, _, eb) = rng.choice(pairs)
+            expect = ACCEPT
+        elif tris and attrs:
+            (a, _, ea), (b, _, eb) = rng.choice(tris), rng.choice(attrs)
+            expect = GARBAGE
+        else:
+            return None
+        for k in ("byteOffset", "byteLength"):
+            ea[k], eb[k] = eb.get(k, 0), ea.get(k, 0)
+        return at("view%d<->%d" % (a, b), expect, must=MO_VIEW_RE)
+    if kind in ("zero_stream", "bomb"):
+        # A hand-made stream of zeros in place of an attribute view's:
+        # valid (within the codec's expansion and the vertex limit), or
+        # announcing more elements than the limit allows, or than its bytes
+        # can hold.
+        plain = [x for x in attrs if x[0] not in doc.position_views() and x[2].get("filter", "NONE") == "NONE"]
+        if kind == "zero_stream" and not plain and rng.random() < 0.7:
+            return None  # mostly a view whose zeros leave a valid mesh
+        v, view, e = rng.choice(plain if plain and rng.random() < 0.7 else attrs)
+        stride, version = e["byteStride"], rng.choice([0, 1])
+        bomb = None if kind == "zero_stream" else rng.choice(["limit", "max", "dishonest"])
+        if bomb == "limit":
+            version = 1
+        # Version 1 is the KHR_ extension's (EXT_ has version 0 only).
+        if version == 1 and (bomb or rng.random() < 0.8):
+            doc.rename(MO_KHR)
+            view = doc.j["bufferViews"][v]
+            e = view["extensions"][MO_KHR]
+        argv, count, expect, must, what = [], None, GARBAGE, MO_LIMIT_RE, "%s.v%d" % (doc.name[:3], version)
+        if kind == "zero_stream":
+            n = rng.choice([e["count"], max(e["count"], 4096), max(e["count"], 1 << 20), max(e["count"], 1 << 22)])
+            ok = (v not in doc.position_views() and e.get("filter", "NONE") == "NONE"
+                  and (version == 0 or doc.name == MO_KHR))
+            expect, must = (ACCEPT if ok else UNKNOWN), None
+        else:
+            what += "," + bomb
+            if bomb == "limit":
+                # Past three times the default 16 M triangles: 512 MiB or
+                # 1 GiB from 0.5 or 1 MB.
+                n = (1 << 28) if stride == 4 else (1 << 26)
+            elif bomb == "max":
+                n = 1 << 20
+                argv = ["--max-triangles", str(max(10000, doc.triangles() + 1000))]
+            else:
+                # Announcing far more elements than the stream's bytes hold.
+                n, count = 4096, rng.choice([1 << 30, 1 << 36])
+        stream = meshopt_zero_stream(n, stride, version)
+        e.update(byteOffset=doc.append(stream), byteLength=len(stream), count=count or n)
+        doc.fit(v)
+        return at("view%d:%s,%d" % (v, what, count or n), expect, must=must, argv=argv, amplify=True)
+    if kind == "flip":
+        k = rng.choice([1, 1, 2, 3, 8])
+        for _ in range(k):
+            doc.bin[off + rng.randrange(length)] ^= rng.randrange(1, 256)
+        return at("view%dx%d" % (v, k), UNKNOWN)
+    if kind == "splice":
+        op = rng.choice(["overwrite", "insert", "delete"])
+        n = rng.randint(1, max(1, min(64, length - 1)))
+        if op == "overwrite":
+            src = rng.randrange(0, len(doc.bin) - n)
+            chunk = bytes(doc.bin[src : src + n])
+            dst = off + rng.randrange(0, length - n + 1)
+            doc.bin[dst : dst + n] = chunk
+        elif op == "insert":
+            where = off + rng.randrange(0, length + 1)
+            chunk = bytes(rng.randrange(256) for _ in range(n)) if rng.random() < 0.5 else bytes(doc.bin[:n])
+            doc.bin[where:where] = chunk
+            e["byteLength"] = length + n
+            doc.shift(off, n, v)
+        else:
+            n = min(n, length - 1)
+            where = off + rng.randrange(0, length - n + 1)
+            del doc.bin[where : where + n]
+            e["byteLength"] = length - n
+            doc.shift(off, -n, v)
+        return at("view%d:%s%d" % (v, op, n), UNKNOWN)
+    if kind in ("stream_cut", "stream_extend"):
+        # An attribute stream's length is known from its headers alone: one
+        # byte less or more is refused (decoder: ends early, or bytes left
+        # over). The index codec reads a table at the end: no verdict.
+        if kind == "stream_cut":
+            e["byteLength"] = length - min(length - 1, rng.choice([1, 2, 4, 16, length // 2, length - 1]))
+        else:
+            e["byteLength"] = length + rng.choice([1, 3, 16, 100])
+        expect = GARBAGE if e["mode"] == "ATTRIBUTES" else UNKNOWN
+        return at("view%d:%d->%d" % (v, length, e["byteLength"]), expect, must=MO_VIEW_RE)
+    if kind == "bin_cut":
+        # Buffer 0 cut short: its bytes fewer than its byteLength, or the
+        # byteLength cut too and a stream past it.
+        lower = rng.random() < 0.5
+        if lower:
+            cut = rng.randrange(4, doc.stream_end())
+            doc.j["buffers"][0]["byteLength"] = cut
+        else:
+            cut = 4 * rng.randrange(0, declared // 4)
+        del doc.bin[cut:]
+        return at("%d%s" % (cut, ",byteLength" if lower else ""), GARBAGE, must=MO_VIEW_RE if lower else None)
+    if kind in ("count_smaller", "count_larger"):
+        step = 3 if e["mode"] == "TRIANGLES" else 1
+        if kind == "count_smaller":
+            e["count"] = max(step, e["count"] - step * rng.choice([1, 2, max(1, e["count"] // (2 * step))]))
+        else:
+            e["count"] += step * rng.choice([1, 2, 16, 1000])
+        doc.fit(v)
+        # Fewer elements than the accessors read: refused (by the decoder or
+        # the accessor's range); more: no verdict.
+        return at("view%d:%d" % (v, e["count"]), GARBAGE if kind == "count_smaller" else UNKNOWN)
+    if kind == "count_huge":
+        count = rng.choice([2 ** 32, 2 ** 40, 2 ** 50, 2 ** 53 - 1, 2 ** 53, 2 ** 64 - 1, 10 ** 15])
+        if e["mode"] == "TRIANGLES":
+            count -= count % 3
+        e["count"] = count
+        doc.fit(v)
+        # Counts the rules let through must be refused by the expansion
+        # bound or the limit; the others by the rules.
+        small = count * e["byteStride"] < 2 ** 53
+        return at("view%d:%d" % (v, count), GARBAGE, must=MO_LIMIT_RE if small else MO_VIEW_RE, amplify=True)
+    if kind == "length_beyond":
+        e["byteLength"] = rng.choice([declared - off + 1, declared - off + 4, declared + 1000, 2 ** 40, 2 ** 53 - 1,
+                                      2 ** 64 - 1])
+        return at("view%d:%d" % (v, e["byteLength"]), GARBAGE, must=MO_VIEW_RE)
+    if kind == "offset_beyond":
+        e["byteOffset"] = rng.choice([declared - length + 1, declared, declared + 4, 2 ** 40, 2 ** 53 - 1, 2 ** 64 - 1])
+        return at("view%d:%d" % (v, e["byteOffset"]), GARBAGE, must=MO_VIEW_RE)
+    if kind == "stride_bad":
+        if e["mode"] == "ATTRIBUTES":
+            e["byteStride"] = rng.choice([0, 2, 3, 6, 10, 258, 260, 512, 2 ** 32])
+        else:
+            e["byteStride"] = rng.choice([0, 1, 3, 6, 8, 16])
+        doc.fit(v)
+        return at("view%d:%s,%d" % (v, e["mode"], e["byteStride"]), GARBAGE, must=MO_VIEW_RE)
+    if kind == "mode_bad":
+        mode = rng.choice(["LINES", "attributes", "", "TRIANGLE_STRIP", "INDEX", 4, None, True, ["ATTRIBUTES"],
+                           "missing"])
+        if mode == "missing":
+            del e["mode"]
+        else:
+            e["mode"] = mode
+        return at("view%d:%s" % (v, json.dumps(mode)), GARBAGE, must=MO_VIEW_RE)
+    if kind == "mode_swap":
+        # A stream decoded with another codec, every rule kept: the header
+        # byte (0xa?, 0xe?, 0xd?) tells them apart, refused.
+        old = e["mode"]
+        new = rng.choice([m for m in MO_MODES if m != old])
+        if new == "TRIANGLES" and e["count"] % 3:
+            new = "INDICES" if old != "INDICES" else "ATTRIBUTES"
+        stride = e["byteStride"]
+        if new == "ATTRIBUTES":
+            stride = 4 if stride in (2, 4) else stride
+        else:
+            stride = stride if stride in (2, 4) else 4
+        e.update(mode=new, byteStride=stride)
+        e.pop("filter", None)
+        if "byteStride" in view:
+            if stride >= 4:
+                view["byteStride"] = stride
+            else:
+                del view["byteStride"]
+        doc.fit(v)
+        return at("view%d:%s->%s" % (v, old, new), GARBAGE, must=MO_VIEW_RE)
+    if kind == "filter_bad":
+        stride, mode = e["byteStride"], e["mode"]
+        if rng.random() < 0.3:
+            f = "COLOR"  # the KHR_ extension's, refused under EXT_
+            if mode != "ATTRIBUTES" or stride not in (4, 8):
+                v, view, e = rng.choice([x for x in attrs if x[2]["byteStride"] in (4, 8)] or [(v, view, e)])
+        elif mode != "ATTRIBUTES":
+            f = rng.choice(["OCTAHEDRAL", "QUATERNION", "EXPONENTIAL"])
+        else:
+            bad = ["LINEAR", "octahedral", "", "NONE ", 0, None, True, ["OCTAHEDRAL"]]
+            bad += (["OCTAHEDRAL"] if stride not in (4, 8) else []) + (["QUATERNION"] if stride != 8 else [])
+            f = rng.choice(bad)
+        e["filter"] = f
+        return at("view%d:%s" % (v, json.dumps(f)), GARBAGE, must=MO_VIEW_RE)
+    if kind == "filter_other":
+        # Another filter the rules allow for the stride: values change, no
+        # verdict.
+        v, view, e = rng.choice(attrs)
+        stride = e["byteStride"]
+        options = ["EXPONENTIAL", "NONE"] + (["OCTAHEDRAL", "COLOR"] if stride in (4, 8) else [])
+        options += ["QUATERNION"] if stride == 8 else []
+        f = rng.choice([o for o in options if o != e.get("filter", "NONE")])
+        if f == "COLOR":
+            doc.rename(MO_KHR)
+            e = doc.j["bufferViews"][v]["extensions"][MO_KHR]
+        e["filter"] = f
+        return at("view%d:%s" % (v, f), UNKNOWN)
+    if kind == "tri_count":
+        v, view, e = rng.choice(tris)
+        c = e["count"]
+        e["count"] = rng.choice([n for n in (c - 1, c + 1, c - 2, c + 2, 1, 2, 4) if n > 0 and n % 3])
+        doc.fit(v)
+        return at("view%d:%d" % (v, e["count"]), GARBAGE, must=MO_VIEW_RE)
+    if kind == "parent_len":
+        stride, total = e["byteStride"], e["byteStride"] * e["count"]
+        if "byteStride" in view and rng.random() < 0.4:
+            view["byteStride"] = rng.choice([s for s in (stride + 4, 2 * stride, 252, 4) if s != stride and s <= 252])
+            what = "byteStride%d" % view["byteStride"]
+        else:
+            view["byteLength"] = rng.choice([total + 1, total - 1, total + stride, total - stride, 2 * total, 1])
+            what = "byteLength%d" % view["byteLength"]
+        doc.fit_fallback()
+        return at("view%d:%s" % (v, what), GARBAGE, must=MO_VIEW_RE)
+    if kind == "value_type":
+        field = rng.choice(["buffer", "byteOffset", "byteLength", "byteStride", "count", "mode"])
+        old = e.get(field, 0)
+        if field == "mode":
+            values = [0, None, ["TRIANGLES"], {"mode": old}, old.lower(), " " + old]
+        else:
+            values = [-1, -old - 1, old + 0.5, 2.5, str(old), None, True, [old], {"value": old}, 1e300, 2 ** 64,
+                      2 ** 53]
+        if field != "byteOffset":
+            values.append("missing")
+        value = rng.choice(values)
+        if value == "missing":
+            del e[field]
+        else:
+            e[field] = value
+        return at("view%d.%s=%s" % (v, field, json.dumps(value)), GARBAGE, must=MO_VIEW_RE)
+    if kind == "buffer_index":
+        # Buffer 1, the fallback, has no data: the primitive is skipped (a
+        # note) and the file has no triangles left; a missing buffer or a
+        # bad index is refused naming the view.
+        b = rng.choice([1, 1, 2, 7, 2 ** 32, 2 ** 53 - 1, 2 ** 53, -1])
+        e["buffer"] = b
+        return at("view%d:%d" % (v, b), GARBAGE, must=None if b == 1 else MO_VIEW_RE)
+    if kind == "fallback_data":
+        # The streams read from buffer 1 given data: zeros (every header
+        # byte wrong, refused), random bytes (no verdict), or a copy of the
+        # BIN chunk, the fallback marker removed (valid).
+        fill = rng.choice(["zeros", "random", "copy"])
+        fb = doc.j["buffers"][1]
+        n = max(fb["byteLength"], len(doc.bin))
+        if fill == "copy":
+            data = bytes(doc.bin) + bytes(n - len(doc.bin))
+            fb.pop("extensions", None)
+            for _, _, x in views:
+                x["buffer"] = 1
+        else:
+            data = bytes(n) if fill == "zeros" else rng.getrandbits(8 * n).to_bytes(n, "little")
+            e["buffer"] = 1
+        fb["byteLength"] = n
+        files = {}
+        if rng.random() < 0.5:
+            import base64
+            fb["uri"] = "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+        else:
+            fb["uri"] = "fallback.bin"
+            files["fallback.bin"] = data
+        expect = {"zeros": GARBAGE, "random": UNKNOWN, "copy": ACCEPT}[fill]
+        return at("%s%s" % (fill, "" if fill == "copy" else ",view%d" % v), expect, must=MO_VIEW_RE, files=files)
+    if kind == "fallback_uri":
+        # The fallback, which a reader that decodes the views never loads,
+        # given a uri that cannot be read: read right, or refused; never a
+        # hang (a FIFO) nor a crash.
+        uri = rng.choice(["missing.bin", "data:application/octet-stream;base64,!!!", "data:,", "",
+                          "../../nonexistent/x.bin", "/nonexistent/x.bin", "%zz.bin", "fifo.bin", "dir.bin",
+                          "/dev/zero"])
+        doc.j["buffers"][1]["uri"] = uri
+        files = {"fifo.bin": ("fifo",)} if uri == "fifo.bin" else {"dir.bin": ("dir",)} if uri == "dir.bin" else {}
+        return at(json.dumps(uri), UNKNOWN, files=files)
+    if kind == "name_lie":
+        lie = rng.choice(["view_misspelled", "required_misspelled", "views_khr", "used_missing"])
+        if lie == "view_misspelled":
+            # A view whose extension is not one the reader knows is a plain
+            # view of the fallback: skipped, no triangles left.
+            view["extensions"] = {rng.choice(["EXT_meshopt_compresion", "ext_meshopt_compression",
+                                              "EXT_meshopt_compression ", "KHR_meshopt"]): e}
+            return at("view%d" % v, GARBAGE)
+        if lie == "required_misspelled":
+            req = doc.j["extensionsRequired"]
+            req[req.index(doc.name)] = "EXT_meshopt_compresion"
+            return at("required", GARBAGE)
+        if lie == "views_khr":
+            # The views under one name, extensionsUsed and Required the
+            # other: no verdict.
+            used, required = list(doc.j["extensionsUsed"]), list(doc.j["extensionsRequired"])
+            if rng.random() < 0.5:
+                doc.rename(MO_KHR)
+            else:
+                used = [MO_KHR if u == MO_EXT else u for u in used]
+                required = [MO_KHR if u == MO_EXT else u for u in required]
+            doc.j["extensionsUsed"], doc.j["extensionsRequired"] = used, required
+            return at("views_%s" % doc.name[:3], UNKNOWN)
+        doc.j["extensionsUsed"] = [u for u in doc.j["extensionsUsed"] if u != doc.name]
+        doc.j["extensionsRequired"] = [u for u in doc.j["extensionsRequired"] if u != doc.name]
+        return at("used_missing", UNKNOWN)
+    raise ValueError(kind)
+
+
+# kind -> weight in the full run (each kind drawn once first); the --quick
+# slice walks QUICK_MESHOPT in order over the two small seeds.
+MESHOPT_KINDS = {
+    "clean": 2, "khr": 2, "gltf_written": 1, "restyled": 2, "int_float": 1, "both_names": 1, "stream_swap": 1,
+    "zero_stream": 3, "flip": 6, "splice": 3, "stream_cut": 3, "stream_extend": 2, "bin_cut": 2,
+    "count_smaller": 1, "count_larger": 1, "count_huge": 4, "bomb": 2, "length_beyond": 2, "offset_beyond": 2,
+    "stride_bad": 3, "mode_bad": 2, "mode_swap": 2, "filter_bad": 3, "filter_other": 1, "tri_count": 2,
+    "parent_len": 2, "value_type": 4, "buffer_index": 2, "fallback_data": 2, "fallback_uri": 2, "name_lie": 2,
+}
+QUICK_MESHOPT = ["clean", "khr", "gltf_written", "count_huge", "flip", "stride_bad", "value_type", "filter_bad",
+                 "mode_swap", "tri_count", "parent_len", "length_beyond", "offset_beyond", "buffer_index",
+                 "fallback_uri", "name_lie", "zero_stream", "bomb", "stream_cut", "splice", "mode_bad", "restyled",
+                 "count_huge", "flip"]
+# Written by `mts convert ... --compress` (MESHOPT_SOURCES): a torus with
+# properties (index stream, positions, octahedral normals, texture
+# coordinates, colours), one without, one of 140k triangles (32-bit
+# indices: a stride-4 index stream; full runs only).
+MESHOPT_SEEDS = ("torus_props.glb", "torus.glb", "torus_u32.glb")
+MESHOPT_QUICK_SEEDS = MESHOPT_SEEDS[:2]
+MESHOPT_SOURCES = {"torus_props.glb": ["--generated", "torus:2k", "--properties"],
+                   "torus.glb": ["--generated", "torus:2k"], "torus_u32.glb": ["--generated", "torus:140k"]}
+_meshopt_expected = {}
+_meshopt_lock = threading.Lock()
+
+
+def meshopt_expected(seeds, name):
+    """The triangles of seed `name`'s quantized, uncompressed twin (`mts
+    convert --quantize`, to OBJ at seed time), read once on first use."""
+    with _meshopt_lock:
+        key = (seeds.dir, name)
+        if key not in _meshopt_expected:
+            pos, tris = read_obj_mesh(seeds.meshopt_obj[name])
+            _meshopt_expected[key] = tri_keys(pos, tris)
+        return _meshopt_expected[key]
+
+
+def gen_meshopt(rng, seeds, index, quick=False):
+    kinds = sorted(MESHOPT_KINDS)
+    if quick:
+        kind = QUICK_MESHOPT[index % len(QUICK_MESHOPT)]
+        name = MESHOPT_QUICK_SEEDS[index % len(MESHOPT_QUICK_SEEDS)]
+    else:
+        if index < len(kinds):
+            kind = kinds[index]
+        else:
+            kind = rng.choices(kinds, weights=[MESHOPT_KINDS[k] for k in kinds])[0]
+        name = rng.choice(MESHOPT_SEEDS)
+    mc = meshopt_case(rng, kind, seeds, name)
+    if mc is None:
+        # The torus with properties has every kind of view.
+        name = MESHOPT_SEEDS[0]
+        mc = meshopt_case(rng, kind, seeds, name)
+    if mc.raw is not None:
+        data, ext = mc.raw, mc.ext
+    else:
+        data, ext, files = mc.doc.write(mc.style)
+        mc.files.update(files)
+    case = Case("meshopt", mc.label, ext, data)
+    for fname, content in mc.files.items():
+        case.files.append((fname, content))
+    names = ["{in}"]
+    opts = dict(MO_AMPLIFY) if mc.amplify else {}
+    # The second run: a reader beside convert. Not build or encode on the
+    # 140k-triangle seed (seconds even when valid; minutes once an edit
+    # makes its vertices coincide).
+    second = [["convert", "{in}", "-o", "{out}.ply"], ["strips", "{in}", "--repeat", "1"]]
+    if name in MESHOPT_QUICK_SEEDS:
+        second += [["build", "{in}", "-o", "{out}.mts"], ["encode", "{in}", "-o", "{out}.stream"]]
+    if mc.expect == ACCEPT:
+        post = obj_check(meshopt_expected(seeds, name), "its quantized uncompressed twin reads")
+        case.run(["convert", "{in}", "-o", "{out}.obj"] + mc.argv, ACCEPT, names=names, post=post, **opts)
+        case.run(rng.choice(second[:3]) + mc.argv, ACCEPT, names=names, **opts)
+    else:
+        case.run(["convert", "{in}", "-o", "{out}.obj"] + mc.argv, mc.expect, names=names, must=mc.must, **opts)
+        case.run(rng.choice(second) + mc.argv, mc.expect, names=names, must=mc.must, **opts)
+    return case
+
+
 # --------------------------------------------------------------------------
 # Running and classifying
 
@@ -4010,7 +4627,47 @@ def make_seeds(mts_bin, root, timeout):
     s.mts3_path = os.path.join(s.dir, "torus_v3.mts")
     for name in ("torus_v3.mts", "ico_optimal_v3.mts"):
         s.v3[name] = s.mts[name]
+    make_meshopt_seeds(s, mts_bin, timeout)
     return s
+
+
+def make_meshopt_seeds(s, mts_bin, timeout):
+    """The meshopt family's seeds: each of MESHOPT_SOURCES written compressed
+    (.glb; the first also as .gltf and .bin) and quantized without
+    compression, the latter converted to OBJ (what an accepted case must
+    read: meshopt_expected)."""
+    s.meshopt, s.meshopt_obj, s.meshopt_gltf = {}, {}, {}
+
+    def mts(argv):
+        p = subprocess.run([mts_bin] + argv, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                           stderr=subprocess.PIPE, timeout=max(60, timeout * 3))
+        if p.returncode != 0 or not os.path.exists(argv[-1]):
+            raise RuntimeError("seed %s: `mts %s` failed: %s" % (os.path.basename(argv[-1]), " ".join(argv),
+                                                                 p.stderr.decode(errors="replace")[:500]))
+
+    for name, source in MESHOPT_SOURCES.items():
+        base = os.path.join(s.dir, name[:-4])
+        mts(["convert"] + source + ["--compress", "-o", base + ".glb"])
+        mts(["convert"] + source + ["--quantize", "-o", base + "_q.glb"])
+        mts(["convert", base + "_q.glb", "-o", base + "_q.obj"])
+        with open(base + ".glb", "rb") as f:
+            data = f.read()
+        try:
+            MeshoptDoc(data)
+        except (ValueError, KeyError, TypeError, IndexError, struct.error) as e:
+            raise RuntimeError("seed %s: the compressed glTF layout is not the one this harness knows: %s" % (name, e))
+        s.meshopt[name] = data
+        s.meshopt_obj[name] = base + "_q.obj"
+    name = MESHOPT_SEEDS[0]
+    base = os.path.join(s.dir, name[:-4])
+    mts(["convert"] + MESHOPT_SOURCES[name] + ["--compress", "-o", base + ".gltf"])
+    with open(base + ".gltf", "rb") as f:
+        text = f.read()
+    uri = json.loads(text)["buffers"][0].get("uri", "")
+    if not re.match(r"^[A-Za-z0-9_.-]+$", uri) or not os.path.isfile(os.path.join(s.dir, uri)):
+        raise RuntimeError("seed %s: the .gltf's buffer 0 is %r, not a .bin beside it" % (name, uri))
+    with open(os.path.join(s.dir, uri), "rb") as f:
+        s.meshopt_gltf[name] = (text, uri, f.read())
 
 
 def build_case(seed, index, family, seeds, family_index, render_budget, quick=False):
@@ -4029,7 +4686,8 @@ def build_case(seed, index, family, seeds, family_index, render_budget, quick=Fa
     if family == "extreme":
         return gen_extreme(rng, seeds, family_index, quick)
     gen = {"gltf": gen_gltf, "amplify": gen_amplify, "fifo": gen_fifo, "output": gen_output, "view": gen_view,
-           "props": gen_props, "reseal": gen_reseal, "hier": gen_hier, "coded": gen_coded}[family]
+           "props": gen_props, "reseal": gen_reseal, "hier": gen_hier, "coded": gen_coded,
+           "meshopt": gen_meshopt}[family]
     return gen(rng, seeds, family_index, quick)
 
 
@@ -4259,7 +4917,8 @@ def run_case(case_spec, ctx):
             for d in opts.get("list", ()):
                 state["list:" + d] = listing(d.replace("{dir}", cdir))
             timeout = min(ctx.timeout, opts["timeout"]) if opts.get("timeout") else ctx.timeout
-            rc, timed_out, elapsed, stderr = execute([ctx.mts] + real, cdir, timeout, ctx.mem_bytes,
+            mem = min(ctx.mem_bytes, opts["mem"]) if opts.get("mem") else ctx.mem_bytes
+            rc, timed_out, elapsed, stderr = execute([ctx.mts] + real, cdir, timeout, mem,
                                                      stdout=opts.get("stdout", "null"), fsize=opts.get("fsize"))
             has_file = names_target and case.family != "args"
             names = None

@@ -33,47 +33,60 @@ fn canonical(t: [u32; 3]) -> [u32; 3] {
     [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
 }
 
-/// `raw` is `mesh` within the quantization of `encoding`: the same
-/// triangles (up to rotation, when compressed), positions within half a
-/// grid step, normals within 2°, texture coordinates within half of their
-/// 12-bit step (4/32,767) and colours within half of 1/255. (The torus
-/// has no two vertices stored alike, so the writer merges none.)
+/// `raw` is `mesh` within the quantization of `encoding`, whatever order
+/// the writer chose for triangles and vertices (the compressed writer
+/// reorders both, and merges vertices stored alike): the same triangles,
+/// corner by corner on the position grid with their winding; every vertex
+/// read back on a grid point within half a step of a source vertex whose
+/// normal is within 2°, texture coordinates within half their 12-bit step
+/// (4/32,767) and colour within half of 1/255.
 fn assert_within_steps(raw: &RawMesh, mesh: &Mesh, encoding: Encoding) {
-    let ours: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
-    let theirs: Vec<[u32; 3]> = raw.triangles.iter().map(|&t| canonical(t)).collect();
-    assert_eq!(ours, theirs, "{encoding:?}");
     let grid = Grid::covering(&mesh.positions);
-    let slack = grid.step * 0.5 + 1e-6 * grid.origin.abs().max_element().max(1.0);
-    for (a, b) in raw.positions.iter().zip(&mesh.positions) {
-        assert!((*a - *b).abs().max_element() <= slack, "{a} {b}");
+    let cell = |p: Vec3| {
+        ((p - grid.origin) / grid.step)
+            .round()
+            .as_ivec3()
+            .to_array()
+    };
+    let corners = |positions: &[Vec3], t: &[u32; 3]| {
+        let k = t.map(|v| cell(positions[v as usize]));
+        let first = (0..3).min_by_key(|&i| k[i]).unwrap();
+        [k[first], k[(first + 1) % 3], k[(first + 2) % 3]]
+    };
+    let mut ours: Vec<_> = mesh
+        .triangles
+        .iter()
+        .map(|t| corners(&mesh.positions, t))
+        .collect();
+    let mut theirs: Vec<_> = raw
+        .triangles
+        .iter()
+        .map(|t| corners(&raw.positions, t))
+        .collect();
+    ours.sort_unstable();
+    theirs.sort_unstable();
+    assert_eq!(ours, theirs, "{encoding:?}");
+    let mut at: std::collections::HashMap<[i32; 3], Vec<usize>> = Default::default();
+    for (v, p) in mesh.positions.iter().enumerate() {
+        at.entry(cell(*p)).or_default().push(v);
     }
     let (p, q) = (&raw.properties, &mesh.properties);
-    for (a, b) in p
-        .normals
-        .as_ref()
-        .unwrap()
-        .iter()
-        .zip(q.normals.as_ref().unwrap())
-    {
-        let cos = a.normalize().dot(b.normalize());
-        assert!(cos >= 2f32.to_radians().cos(), "{a} {b}");
-    }
-    for (a, b) in p.uvs.as_ref().unwrap().iter().zip(q.uvs.as_ref().unwrap()) {
+    let slack = grid.step * 0.5 + 1e-6 * grid.origin.abs().max_element().max(1.0);
+    for (v, position) in raw.positions.iter().enumerate() {
+        let sources = &at[&cell(*position)];
+        let matches = |s: usize| {
+            let n = p.normals.as_ref().unwrap()[v].normalize();
+            let m = q.normals.as_ref().unwrap()[s].normalize();
+            let t = p.uvs.as_ref().unwrap()[v] - q.uvs.as_ref().unwrap()[s];
+            let c = p.colors.as_ref().unwrap()[v] - q.colors.as_ref().unwrap()[s];
+            (*position - mesh.positions[s]).abs().max_element() <= slack
+                && n.dot(m) >= 2f32.to_radians().cos()
+                && t.abs().max_element() <= 4.0 / 32767.0 + 1e-6
+                && c.abs().max_element() <= 0.5 / 255.0 + 1e-6
+        };
         assert!(
-            (*a - *b).abs().max_element() <= 4.0 / 32767.0 + 1e-6,
-            "{a} {b}"
-        );
-    }
-    for (a, b) in p
-        .colors
-        .as_ref()
-        .unwrap()
-        .iter()
-        .zip(q.colors.as_ref().unwrap())
-    {
-        assert!(
-            (*a - *b).abs().max_element() <= 0.5 / 255.0 + 1e-6,
-            "{a} {b}"
+            sources.iter().any(|&s| matches(s)),
+            "{encoding:?}: vertex {v} at {position} matches none of {sources:?}"
         );
     }
 }

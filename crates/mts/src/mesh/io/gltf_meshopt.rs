@@ -130,14 +130,14 @@ fn compressed_view(view: &Value) -> std::result::Result<Option<Compressed>, Stri
     let length = integer("byteLength", None)?;
     let stride = integer("byteStride", None)?;
     let count = integer("count", None)?;
-    let mode = match object.get("mode").and_then(Value::as_str) {
-        Some("ATTRIBUTES") => Mode::Attributes,
-        Some("TRIANGLES") => Mode::Triangles,
-        Some("INDICES") => Mode::Indices,
-        other => {
+    let mode = match object.get("mode").map(|m| (m, m.as_str())) {
+        Some((_, Some("ATTRIBUTES"))) => Mode::Attributes,
+        Some((_, Some("TRIANGLES"))) => Mode::Triangles,
+        Some((_, Some("INDICES"))) => Mode::Indices,
+        None => return Err(fail("`mode` is missing".into())),
+        Some((m, _)) => {
             return Err(fail(format!(
-                "`mode` is {}, not ATTRIBUTES, TRIANGLES or INDICES",
-                other.map_or_else(|| "missing".to_owned(), |m| format!("{m:?}"))
+                "`mode` is {m}, not ATTRIBUTES, TRIANGLES or INDICES"
             )))
         }
     };
@@ -148,10 +148,10 @@ fn compressed_view(view: &Value) -> std::result::Result<Option<Compressed>, Stri
         Some(Some("QUATERNION")) => Filter::Quaternion,
         Some(Some("EXPONENTIAL")) => Filter::Exponential,
         Some(Some("COLOR")) if is_khr => Filter::Color,
-        Some(other) => {
+        Some(_) => {
             return Err(fail(format!(
                 "`filter` is {}, not NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL{}",
-                other.map_or_else(|| "not a string".to_owned(), |m| format!("{m:?}")),
+                object["filter"],
                 if is_khr { " or COLOR" } else { "" }
             )))
         }

@@ -75,9 +75,11 @@ pub fn save_gltf(mesh: &Mesh, path: &Path) -> Result<()> {
 /// [`save_gltf`] with the vertex data stored as `encoding` says
 /// ([`Encoding::Quantized`], [`Encoding::Compressed`]: positions on a
 /// 14-bit grid placed by the node's transform, the other attributes as
-/// [`super::gltf_compress`] lists). The triangles and vertices are written
-/// in `mesh`'s order: for the codecs to do well, give a mesh in
-/// vertex-cache order ([`super::order_for_cache`]).
+/// `gltf_compress` lists; vertices stored alike merged). Quantized, the
+/// triangles are written in `mesh`'s order (give a mesh in vertex-cache
+/// order, [`super::order_for_cache`]); compressed, they are first put in
+/// the strip-like cache order the index codec does best with. Vertices are
+/// numbered in order of first use.
 ///
 /// # Errors
 /// As [`save_gltf`].
@@ -127,7 +129,7 @@ pub enum Encoding {
     #[default]
     Plain,
     /// Attributes quantized (`KHR_mesh_quantization`, the layout of
-    /// [`super::gltf_compress`]), views uncompressed.
+    /// `gltf_compress`), views uncompressed.
     Quantized,
     /// Quantized, then every vertex and index view coded with
     /// meshoptimizer's codecs (`EXT_meshopt_compression`): what gltfpack
