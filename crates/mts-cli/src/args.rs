@@ -150,12 +150,13 @@ impl MeshSource {
 pub struct GltfOut {
     /// Write glTF compressed as engines ship it: quantized attributes
     /// (KHR_mesh_quantization) coded with meshoptimizer's codecs
-    /// (EXT_meshopt_compression), the level in vertex-cache order. About
-    /// gltfpack -cc's size; a .glb or .gltf output only.
+    /// (EXT_meshopt_compression), the level in the strip-like vertex-cache
+    /// order the codec does best with. About gltfpack -cc's size; a .glb or
+    /// .gltf output only.
     #[arg(long)]
     pub compress: bool,
     /// Write glTF quantized (KHR_mesh_quantization: 14-bit positions,
-    /// 8-bit normals and colours, 16-bit texture coordinates) but not
+    /// 8-bit normals and colours, 12-bit texture coordinates) but not
     /// compressed, the level in vertex-cache order.
     #[arg(long, conflicts_with = "compress")]
     pub quantize: bool,

@@ -13,6 +13,14 @@
 //! fixed and small, and the reader's tests parse every written file back
 //! with the `gltf` crate's full validation.
 //!
+//! **Quantized and compressed** ([`Encoding`], [`save_gltf_as`]): the
+//! streams of `gltf_compress` (`KHR_mesh_quantization`), the node placing
+//! the position grid; compressed, every vertex and index view is coded in
+//! buffer 0 and decodes into buffer 1, a fallback without data
+//! (`EXT_meshopt_compression`, required). Those files pass the Khronos
+//! validator (checked outside the tests: the `gltf` crate's validation
+//! refuses any required extension it does not implement).
+//!
 //! **The texture.** A `.glb` is one self-contained file: a
 //! [`Texture::File`] is read and its bytes embedded (a file that cannot be
 //! read is an error naming it; loading already drops, with a warning,
