@@ -74,6 +74,13 @@ pub(super) struct Endpoint {
     /// their cycles by swapping the two links. The position sits beside
     /// the link so a walk loads one line per member.
     pub(super) members: Vec<(Vec3, u32)>,
+    /// An upper bound on the distance from `v`'s input position to the
+    /// input position of any member of its cycle (0 alone); moving `a`
+    /// onto `b` raises `b`'s to `|a - b| + radius[a]` where larger (the
+    /// triangle inequality, rounded up). [`Contractor::forward_error`]
+    /// skips the walk over `a`'s members when no member can be farther
+    /// from `b`'s fan than the distance already found.
+    pub(super) radius: Vec<f64>,
 }
 
 impl Place for Endpoint {
@@ -94,7 +101,12 @@ impl Place for Endpoint {
         let members = (0..mesh.vertex_count() as u32)
             .map(|v| (mesh.positions[v as usize], v))
             .collect();
-        Endpoint { anchors, members }
+        let radius = vec![0.0; mesh.vertex_count()];
+        Endpoint {
+            anchors,
+            members,
+            radius,
+        }
     }
 
     fn created(&self, _: usize) -> DVec3 {
@@ -139,6 +151,12 @@ impl Place for Endpoint {
         let (after_a, after_b) = (this.members[a as usize].1, this.members[b as usize].1);
         this.members[a as usize].1 = after_b;
         this.members[b as usize].1 = after_a;
+        let (pa, pb) = (this.members[a as usize].0, this.members[b as usize].0);
+        let reach = (pa.as_dvec3() - pb.as_dvec3()).length() + this.radius[a as usize];
+        // Rounded up, so that the bound stays above the true distance.
+        let reach = reach * (1.0 + 1e-12);
+        let r = &mut this.radius[b as usize];
+        *r = r.max(reach);
         b
     }
 
