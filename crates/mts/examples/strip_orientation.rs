@@ -7,7 +7,10 @@
 //! triangle's winding; an odd one would need an extra index). Prints the
 //! single-band model's indices per triangle (what the strips send over the
 //! triangles drawn) at each share, for the strips as stripified and as
-//! turned, and how many runs were turned.
+//! turned, and how many runs were turned. Then step 0e: the stripifier
+//! itself laying strips along the sequence (`stripify_along`: a
+//! candidate's score gains the difference of its death LoD from the
+//! current triangle's), as a tie-break and as a cost.
 //!
 //! `cargo run --release -p mts --example strip_orientation -- MESH [SHARE...]`
 //! (shares in percent; default 100 75 50 25 10 5 1).
@@ -87,22 +90,66 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          more would be but have an odd index count",
         strips.run_count()
     );
+    // Step 0e: strips laid along the sequence by the stripifier itself
+    // (`stripify_along`), the death term as a tie-break (0.49) and as a
+    // real cost (2, 8).
+    let deaths: Vec<u32> = mesh
+        .triangles
+        .iter()
+        .map(|&t| death(&collapses, t) as u32)
+        .collect();
+    // The death term acts in the local pass; the global (patch) pass is
+    // left out of these variants so that it reaches every triangle, and
+    // the local pass alone is their baseline.
+    let local = StripifyOptions {
+        patches: false,
+        ..StripifyOptions::default()
+    };
+    let mut variants = vec![
+        ("as stripified", strips.clone()),
+        ("turned", turned_strips),
+        ("local pass only", stripify(&mesh, &local)),
+    ];
+    for weight in [0.49f32, 2.0, 8.0] {
+        let along = mts::strip::stripify_along(&mesh, &local, &deaths, weight);
+        assert_eq!(
+            mts::strip::sorted_canonical(&along.triangles()),
+            mts::strip::sorted_canonical(&strips.triangles())
+        );
+        variants.push((
+            match weight {
+                w if w < 1.0 => "along, tie-break",
+                w if w < 4.0 => "along, weight 2",
+                _ => "along, weight 8",
+            },
+            along,
+        ));
+    }
     let options = BuildOptions {
         band_slack: f64::INFINITY,
         ..BuildOptions::default()
     };
-    let stripified = build(&mesh, &strips, &collapses, &options);
-    let oriented = build(&mesh, &turned_strips, &collapses, &options);
-    let (mut ea, mut eb) = (Extractor::new(&stripified), Extractor::new(&oriented));
-    println!("share: indices per triangle, single band, as stripified -> turned");
+    let models: Vec<_> = variants
+        .iter()
+        .map(|(_, s)| build(&mesh, s, &collapses, &options))
+        .collect();
+    let mut extractors: Vec<_> = models.iter().map(Extractor::new).collect();
+    println!(
+        "share: indices per triangle, single band: {}",
+        variants
+            .iter()
+            .map(|(n, _)| *n)
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
     for share in shares {
-        let lod = stripified.lod_for_ratio(share / 100.0);
-        let a = sent_per_triangle(&stripified, &mut ea, lod);
-        let b = sent_per_triangle(&oriented, &mut eb, lod);
-        println!(
-            "  {share:>5}%: {a:.3} -> {b:.3} ({:+.1}%)",
-            (b / a - 1.0) * 100.0
-        );
+        let lod = models[0].lod_for_ratio(share / 100.0);
+        let row: Vec<String> = models
+            .iter()
+            .zip(&mut extractors)
+            .map(|(m, ex)| format!("{:.3}", sent_per_triangle(m, ex, lod)))
+            .collect();
+        println!("  {share:>5}%: {}", row.join(" | "));
     }
     Ok(())
 }

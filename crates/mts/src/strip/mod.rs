@@ -16,7 +16,7 @@ pub mod stats;
 pub mod stripify;
 pub mod vertex_work;
 
-pub use stripify::{stripify, StripifyOptions};
+pub use stripify::{stripify, stripify_along, StripifyOptions};
 
 use crate::error::{Error, Result};
 use crate::mesh::is_degenerate;

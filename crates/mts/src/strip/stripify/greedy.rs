@@ -27,6 +27,13 @@ pub(super) struct Walk<'a> {
     free_deg: Vec<u8>,
     buckets: [Vec<u32>; 4],
     pub(super) swap_penalty: f32,
+    /// Strips laid along the contraction sequence (an experiment,
+    /// [`super::stripify_along`]): each triangle's death LoD, and the
+    /// weight of `|death(next) - death(current)| / (max death + 1)` added
+    /// to a candidate's score; `None` for the plain pass.
+    pub(super) death: Option<(&'a [u32], f32)>,
+    /// The largest death LoD plus one (the term's scale).
+    pub(super) death_span: u32,
 }
 
 impl<'a> Walk<'a> {
@@ -47,6 +54,19 @@ impl<'a> Walk<'a> {
             free_deg,
             buckets,
             swap_penalty: 0.5,
+            death: None,
+            death_span: 1,
+        }
+    }
+
+    /// The death term of entering `cand` from `cur` (0 without deaths).
+    fn death_term(&self, cur: u32, cand: u32) -> f32 {
+        match self.death {
+            None => 0.0,
+            Some((death, weight)) => {
+                let (a, b) = (death[cur as usize], death[cand as usize]);
+                weight * a.abs_diff(b) as f32 / (self.death_span as f32)
+            }
         }
     }
 
@@ -111,7 +131,8 @@ impl<'a> Walk<'a> {
                         self.swap_penalty
                     } else {
                         0.0
-                    };
+                    }
+                    + self.death_term(cursor.cur, cand);
                 if best.is_none_or(|(b, _)| score < b) {
                     best = Some((score, s));
                 }

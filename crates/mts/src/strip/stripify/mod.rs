@@ -122,11 +122,37 @@ pub fn stripify(mesh: &Mesh, options: &StripifyOptions) -> Strips {
             let adjacency = TriangleAdjacency::new(mesh);
             (adjacency, handle.join().expect("stripify worker panicked"))
         });
-        stripify_impl(mesh, &adjacency, Some(longest), options)
+        stripify_impl(mesh, &adjacency, Some(longest), options, None)
     } else {
         let adjacency = TriangleAdjacency::new(mesh);
-        stripify_impl(mesh, &adjacency, None, options)
+        stripify_impl(mesh, &adjacency, None, options, None)
     }
+}
+
+/// [`stripify`] with strips laid along a contraction sequence (issue 34's
+/// experiment, `docs/experiments/strip-lifetimes.md`, step 0e): `death[t]`
+/// is the LoD at which triangle `t` dies, and the local pass adds
+/// `weight × |death(next) − death(current)| / (max death + 1)` to each
+/// candidate's score, so that a strip's neighbouring triangles die at
+/// close LoDs. Below 0.5 (the scores' step) it only breaks ties. Not used
+/// by the model builder: it did not pay (see the experiment).
+///
+/// # Panics
+/// If `death` does not hold one LoD per triangle.
+#[must_use]
+pub fn stripify_along(
+    mesh: &Mesh,
+    options: &StripifyOptions,
+    death: &[u32],
+    weight: f32,
+) -> Strips {
+    assert_eq!(
+        death.len(),
+        mesh.triangle_count(),
+        "one death LoD per triangle"
+    );
+    let adjacency = TriangleAdjacency::new(mesh);
+    stripify_impl(mesh, &adjacency, None, options, Some((death, weight)))
 }
 
 /// [`stripify`] with [`StripifyOptions::cache_aware`].
@@ -155,8 +181,13 @@ fn stripify_impl(
     adjacency: &TriangleAdjacency,
     longest: Option<Vec<u8>>,
     options: &StripifyOptions,
+    death: Option<(&[u32], f32)>,
 ) -> Strips {
-    let fresh = Walk::new(&mesh.triangles, adjacency);
+    let mut fresh = Walk::new(&mesh.triangles, adjacency);
+    if let Some((d, _)) = death {
+        fresh.death = death;
+        fresh.death_span = d.iter().max().map_or(1, |m| m + 1);
+    }
     let penalties: Vec<f32> = options.swap_penalties.iter().flatten().copied().collect();
     let mut penalties = if penalties.is_empty() {
         vec![0.5]
@@ -231,4 +262,32 @@ fn stripify_impl(
         mesh.vertex_count() as u32,
         mesh.triangle_count(),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::strip::sorted_canonical;
+
+    /// Laid along any death order, the strips draw exactly the mesh's
+    /// triangles with their winding; a weight of zero is the plain local
+    /// pass; a heavy weight changes the strips.
+    #[test]
+    fn strips_along_a_death_order_draw_the_mesh() {
+        let mesh = crate::mesh::generate::torus(24, 12);
+        let local = StripifyOptions {
+            patches: false,
+            ..StripifyOptions::default()
+        };
+        let death: Vec<u32> = (0..mesh.triangle_count() as u32)
+            .map(|t| (t * 7919) % 101)
+            .collect();
+        let want = sorted_canonical(&mesh.triangles);
+        let plain = stripify(&mesh, &local);
+        assert_eq!(stripify_along(&mesh, &local, &death, 0.0), plain);
+        let heavy = stripify_along(&mesh, &local, &death, 8.0);
+        heavy.validate().unwrap();
+        assert_eq!(sorted_canonical(&heavy.triangles()), want);
+        assert_ne!(heavy, plain);
+    }
 }
