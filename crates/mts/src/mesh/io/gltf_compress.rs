@@ -311,12 +311,26 @@ fn colors(colors: &[Vec4]) -> Vec<u8> {
 }
 
 /// `data` (`count` elements of `stride` bytes, stride a multiple of 4 up
-/// to 256) in version 0 of the attribute codec.
+/// to 256) in version 0 of the attribute codec (the one
+/// `EXT_meshopt_compression` specifies).
 pub(super) fn encode_attributes(data: &[u8], stride: usize) -> Vec<u8> {
+    encode_attributes_as(data, stride, 2, 0)
+}
+
+/// [`encode_attributes`] at encoder `level` (0–3, used by version 1 only)
+/// and codec `version` (0 or 1).
+pub(super) fn encode_attributes_as(
+    data: &[u8],
+    stride: usize,
+    level: i32,
+    version: i32,
+) -> Vec<u8> {
     assert!(stride % 4 == 0 && stride <= 256 && data.len() % stride == 0);
+    assert!((0..=1).contains(&version) && (0..=3).contains(&level));
     let count = data.len() / stride;
     // SAFETY: `data` holds `count × stride` bytes; the output is sized by
-    // the encoder's own bound; stride satisfies the encoder's asserts.
+    // the encoder's own bound; stride, level and version satisfy the
+    // encoder's asserts.
     unsafe {
         let bound = meshopt::ffi::meshopt_encodeVertexBufferBound(count, stride);
         let mut out = vec![0u8; bound];
@@ -326,8 +340,8 @@ pub(super) fn encode_attributes(data: &[u8], stride: usize) -> Vec<u8> {
             data.as_ptr().cast(),
             count,
             stride,
-            2,
-            0,
+            level,
+            version,
         );
         assert!(n > 0, "the attribute encoder's bound holds its output");
         out.truncate(n);
