@@ -1346,6 +1346,10 @@ fn primitives_without_positions_or_data_are_skipped() {
         .unwrap()
         .triangles
         .is_empty());
+    assert_eq!(
+        mts::mesh::io::gltf_part_count(&text, Path::new("t.gltf")).unwrap(),
+        0
+    );
     match load_bytes(&text, Path::new("t.gltf")) {
         Err(Error::InvalidMesh { .. }) => {}
         other => panic!("expected an empty mesh, got {other:?}"),

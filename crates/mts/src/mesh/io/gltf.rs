@@ -1157,7 +1157,7 @@ impl<'a> Reader<'a> {
                     }
                 }
             },
-            Target::Count { meshes, parts } => {
+            Target::Count { meshes, .. } => {
                 if meshes.insert(m) {
                     for (p, primitive) in mesh.primitives.iter().enumerate() {
                         let place = Place::element(&format!("mesh {m} primitive"), p as u64);
@@ -1166,9 +1166,14 @@ impl<'a> Reader<'a> {
                         };
                         let positions = primitive
                             .attributes
-                            .contains_key(&Checked::Valid(Semantic::Positions));
-                        if is_triangles(mode) && positions {
-                            *parts += 1;
+                            .get(&Checked::Valid(Semantic::Positions))
+                            .map(|a| a.value());
+                        // As `geometry` skips: no POSITION, or data in a
+                        // buffer that has none.
+                        let drawn = is_triangles(mode)
+                            && positions.is_some_and(|a| self.dataless_buffer(a).is_none());
+                        if let Target::Count { parts, .. } = &mut self.target {
+                            *parts += usize::from(drawn);
                         }
                     }
                 }
