@@ -176,10 +176,10 @@ impl GltfOut {
     /// Refuses a quantized or compressed encoding for an output that is
     /// not glTF.
     pub fn check(&self, output: &std::path::Path) -> Result<()> {
-        let gltf = output
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+        let gltf = matches!(
+            mts::mesh::io::Format::detect(output, &[]),
+            Ok(mts::mesh::io::Format::Gltf)
+        );
         if self.encoding() != mts::mesh::io::Encoding::Plain && !gltf {
             anyhow::bail!(
                 "{}: --compress and --quantize write glTF: name the output .glb or .gltf",

@@ -1164,14 +1164,7 @@ impl<'a> Reader<'a> {
                         let Checked::Valid(mode) = primitive.mode else {
                             return Err(self.fail(place, "unknown primitive mode".into()));
                         };
-                        let positions = primitive
-                            .attributes
-                            .get(&Checked::Valid(Semantic::Positions))
-                            .map(|a| a.value());
-                        // As `geometry` skips: no POSITION, or data in a
-                        // buffer that has none.
-                        let drawn = is_triangles(mode)
-                            && positions.is_some_and(|a| self.dataless_buffer(a).is_none());
+                        let drawn = is_triangles(mode) && self.undrawable(primitive).is_none();
                         if let Target::Count { parts, .. } = &mut self.target {
                             *parts += usize::from(drawn);
                         }
@@ -1210,26 +1203,13 @@ impl<'a> Reader<'a> {
                 .get(&Checked::Valid(semantic))
                 .map(|a| a.value())
         };
-        let Some(pa) = attribute(Semantic::Positions) else {
-            // glTF 2.0, "Meshes": without positions a client should skip
-            // the primitive's rendering.
-            self.note(format!("{place} has no POSITION attribute: skipped"));
-            return Ok(None);
-        };
-        let used = primitive
-            .attributes
-            .values()
-            .map(|a| a.value())
-            .chain(primitive.indices.map(|a| a.value()));
-        if let Some(b) = used.filter_map(|a| self.dataless_buffer(a)).next() {
-            // A buffer of a .gltf without uri has no bytes anywhere: the
-            // validator lets it be, and there is nothing to draw.
-            self.note(format!(
-                "{place} reads buffer {b}, which has no uri (and is not a .glb's BIN chunk), so \
-                 no data: skipped"
-            ));
+        if let Some(why) = self.undrawable(primitive) {
+            self.note(format!("{place} {why}: skipped"));
             return Ok(None);
         }
+        let Some(pa) = attribute(Semantic::Positions) else {
+            unreachable!("undrawable() refuses a primitive without POSITION");
+        };
         let positions = self.elements(pa, &[3], "POSITION", place)?;
         let count = positions.count;
         self.count_vertices(count, place)?;
@@ -1827,6 +1807,30 @@ impl<'a> Reader<'a> {
                 ),
             )),
         }
+    }
+
+    /// Why a triangle primitive is skipped rather than read, if it is: no
+    /// `POSITION` (glTF 2.0, "Meshes": a client should then skip the
+    /// primitive's rendering), or an accessor reading a buffer without data
+    /// (a `.gltf` buffer without uri has no bytes anywhere: the validator
+    /// lets it be, and there is nothing to draw). One rule for reading
+    /// ([`Reader::geometry`]) and for counting parts.
+    fn undrawable(&self, primitive: &json::mesh::Primitive) -> Option<String> {
+        if !primitive
+            .attributes
+            .contains_key(&Checked::Valid(Semantic::Positions))
+        {
+            return Some("has no POSITION attribute".into());
+        }
+        let used = primitive
+            .attributes
+            .values()
+            .map(|a| a.value())
+            .chain(primitive.indices.map(|a| a.value()));
+        let b = used.filter_map(|a| self.dataless_buffer(a)).next()?;
+        Some(format!(
+            "reads buffer {b}, which has no uri (and is not a .glb's BIN chunk), so no data"
+        ))
     }
 
     /// The buffer without data (no uri, and not buffer 0 of a `.glb` with

@@ -72,7 +72,7 @@ pub(super) fn quantize(
 ) -> Quantized {
     let octahedral = compressed;
     let p = &mesh.properties;
-    let all_positions = positions(&mesh.positions, grid).0;
+    let all_positions = positions(&mesh.positions, grid);
     let all_normals = normals.map(|n| {
         if octahedral {
             octahedral_normals(n)
@@ -227,22 +227,16 @@ impl Grid {
     }
 }
 
-/// Positions as u16 × 4 (the fourth 0): 8 bytes each, and the least and
-/// greatest quantized coordinates (the accessor's `min` and `max`).
-fn positions(points: &[Vec3], grid: &Grid) -> (Vec<u8>, [u16; 3], [u16; 3]) {
-    let mut lo = [u16::MAX; 3];
-    let mut hi = [0u16; 3];
+/// Positions as u16 × 4 (the fourth 0): 8 bytes each.
+fn positions(points: &[Vec3], grid: &Grid) -> Vec<u8> {
     let mut out = Vec::with_capacity(points.len() * 8);
     for p in points {
-        let q = grid.quantize(*p);
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-            out.extend_from_slice(&q[k].to_le_bytes());
+        for q in grid.quantize(*p) {
+            out.extend_from_slice(&q.to_le_bytes());
         }
         out.extend_from_slice(&[0, 0]);
     }
-    (out, lo, hi)
+    out
 }
 
 /// Unit normals as normalized i8 × 3 (and a zero byte).
@@ -369,15 +363,18 @@ mod tests {
         let grid = Grid::covering(&points);
         assert_eq!(grid.origin, Vec3::new(-1.0, -0.2, 0.25));
         assert!((grid.step - 4.0 / 16383.0).abs() < 1e-9);
-        let (bytes, lo, hi) = positions(&points, &grid);
+        let bytes = positions(&points, &grid);
         assert_eq!(bytes.len(), 24);
-        assert_eq!((lo, hi[0]), ([0, 0, 0], 16383));
+        let coordinate = |k: usize, i: usize| {
+            u16::from_le_bytes([bytes[k * 8 + 2 * i], bytes[k * 8 + 2 * i + 1]])
+        };
+        let lo: Vec<u16> = (0..3)
+            .map(|i| (0..3).map(|k| coordinate(k, i)).min().unwrap())
+            .collect();
+        let hi0 = (0..3).map(|k| coordinate(k, 0)).max().unwrap();
+        assert_eq!((lo, hi0), (vec![0, 0, 0], 16383));
         for (k, p) in points.iter().enumerate() {
-            let q: Vec<f32> = (0..3)
-                .map(|i| {
-                    u16::from_le_bytes([bytes[k * 8 + 2 * i], bytes[k * 8 + 2 * i + 1]]) as f32
-                })
-                .collect();
+            let q: Vec<f32> = (0..3).map(|i| f32::from(coordinate(k, i))).collect();
             let back = grid.origin + Vec3::from_slice(&q) * grid.step;
             assert!(
                 (back - *p).abs().max_element() <= grid.step / 2.0 + 1e-6,

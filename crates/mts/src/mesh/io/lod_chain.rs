@@ -159,7 +159,9 @@ pub fn chain_from_collapses(
 /// `extensionsUsed` lists `MSFT_lod`, `extensionsRequired` does not. A
 /// chain of one level is a plain glTF file without the extension. Levels
 /// with a texture share material 0 and its image (embedded in a `.glb`;
-/// see `save_gltf` for how a `.gltf` refers to it). `encoding` stores the
+/// see `save_gltf` for how a `.gltf` refers to it); compressed, the writer
+/// then puts it in the codec's strip-like cache order (`save_gltf_as`).
+/// `encoding` stores the
 /// vertex data plain, quantized or compressed (`save_gltf_as`); quantized
 /// levels share one position grid (over every level's positions) and so
 /// one node transform.
@@ -227,6 +229,9 @@ pub fn save_lod_chain(
     let mut meshes = Vec::with_capacity(levels.len());
     let mut nodes = Vec::with_capacity(levels.len());
     for (k, level) in levels.iter().enumerate() {
+        // Compressed, the writer reorders for its codec, and does better
+        // from the cache order than from the level's own (the bunny's file
+        // 208,944 bytes against 210,088).
         let ordered = order_for_cache(&level.mesh);
         let mut primitive = out
             .primitive(&ordered, path)

@@ -59,17 +59,6 @@ impl<'a> Walk<'a> {
         }
     }
 
-    /// The death term of entering `cand` from `cur` (0 without deaths).
-    fn death_term(&self, cur: u32, cand: u32) -> f32 {
-        match self.death {
-            None => 0.0,
-            Some((death, weight)) => {
-                let (a, b) = (death[cur as usize], death[cand as usize]);
-                weight * a.abs_diff(b) as f32 / (self.death_span as f32)
-            }
-        }
-    }
-
     /// Free neighbours of the free triangle `t`.
     pub(super) fn free_neighbours(&self, t: u32) -> u8 {
         self.free_deg[t as usize]
@@ -118,6 +107,22 @@ impl<'a> Walk<'a> {
     /// swap penalty if entering it needs a swap (see the `path` module:
     /// a swap is three consecutive shared edges around one vertex).
     pub(super) fn grow_back(&mut self, path: &mut Vec<u32>) {
+        match self.death {
+            // The plain pass compiles without the death term.
+            None => self.grow_back_with(path, |_, _| 0.0),
+            Some((death, weight)) => {
+                let span = self.death_span as f32;
+                self.grow_back_with(path, move |cur: u32, cand: u32| {
+                    weight * death[cur as usize].abs_diff(death[cand as usize]) as f32 / span
+                });
+            }
+        }
+    }
+
+    /// [`Walk::grow_back`] with `extra(current, candidate)` added to each
+    /// candidate's score.
+    #[inline(always)]
+    fn grow_back_with(&mut self, path: &mut Vec<u32>, extra: impl Fn(u32, u32) -> f32) {
         let mut cursor = Cursor::at_back(self, path);
         loop {
             let ns = &self.adj.neighbours[cursor.cur as usize];
@@ -132,7 +137,7 @@ impl<'a> Walk<'a> {
                     } else {
                         0.0
                     }
-                    + self.death_term(cursor.cur, cand);
+                    + extra(cursor.cur, cand);
                 if best.is_none_or(|(b, _)| score < b) {
                     best = Some((score, s));
                 }
