@@ -36,7 +36,7 @@ mod grouping;
 mod partition;
 mod runtime;
 mod select;
-mod strips;
+pub(crate) mod strips;
 
 pub use build::{build, build_with_progress, BuildProgress};
 pub use cracks::cracks;

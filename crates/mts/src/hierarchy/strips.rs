@@ -80,7 +80,7 @@ pub(super) fn strip_clusters(h: &mut Hierarchy, triangles: &[[u32; 3]], options:
 /// (`vertices[i]` is local vertex `i`) and the local triangles. `remap` is
 /// all `u32::MAX` on entry and on return (one per input vertex). The
 /// submesh of a cluster here and of a group in `build.rs`.
-pub(super) fn renumber(triangles: &[[u32; 3]], remap: &mut [u32]) -> (Vec<u32>, Vec<[u32; 3]>) {
+pub(crate) fn renumber(triangles: &[[u32; 3]], remap: &mut [u32]) -> (Vec<u32>, Vec<[u32; 3]>) {
     let mut vertices: Vec<u32> = Vec::new();
     let local: Vec<[u32; 3]> = triangles
         .iter()

@@ -169,34 +169,9 @@ pub fn build_with_progress(
         "the MTS model cannot hold vertices created with properties (optimal placement on a mesh with properties)"
     );
     let max_lod = collapses.max_lod() as u32;
-    let mut positions = mesh.positions.clone();
-    positions.extend_from_slice(collapses.appended());
-    // The slack the bands use is the one the model records, so that its
-    // file loads again: NaN or below MIN_BAND_SLACK means MIN_BAND_SLACK.
-    let effective = BuildOptions {
-        band_slack: if options.band_slack >= MIN_BAND_SLACK {
-            options.band_slack
-        } else {
-            MIN_BAND_SLACK
-        },
-        ..options.clone()
-    };
+    let effective = effective_options(options);
     let options = &effective;
-    let ctx = Context {
-        // Bands are stripified from the strips' own triangles, so that a
-        // model built again from its file (which stores the strips) is the
-        // same.
-        base: Mesh {
-            positions: mesh.positions.clone(),
-            triangles: strips.triangles(),
-            properties: Default::default(),
-        },
-        positions,
-        collapses,
-        options,
-        slack: options.band_slack,
-        max_lod,
-    };
+    let ctx = Context::new(mesh, strips, collapses, options);
     let starts = ctx.segment_starts();
     let done = std::sync::atomic::AtomicUsize::new(0);
     let next = std::sync::atomic::AtomicUsize::new(0);
@@ -283,18 +258,57 @@ pub fn build_with_progress(
     model
 }
 
-/// What every band's construction reads.
-struct Context<'a> {
-    base: Mesh,
-    /// Every vertex, appended ones too.
-    positions: Vec<glam::Vec3>,
-    collapses: &'a Collapses,
-    options: &'a BuildOptions,
-    slack: f64,
-    max_lod: u32,
+/// `options` with the slack the bands use, the one the model records, so
+/// that its file loads again: NaN or below [`MIN_BAND_SLACK`] means
+/// [`MIN_BAND_SLACK`].
+pub(super) fn effective_options(options: &BuildOptions) -> BuildOptions {
+    BuildOptions {
+        band_slack: if options.band_slack >= MIN_BAND_SLACK {
+            options.band_slack
+        } else {
+            MIN_BAND_SLACK
+        },
+        ..options.clone()
+    }
 }
 
-impl Context<'_> {
+/// What every band's construction reads.
+pub(super) struct Context<'a> {
+    pub(super) base: Mesh,
+    /// Every vertex, appended ones too.
+    pub(super) positions: Vec<glam::Vec3>,
+    pub(super) collapses: &'a Collapses,
+    pub(super) options: &'a BuildOptions,
+    pub(super) slack: f64,
+    pub(super) max_lod: u32,
+}
+
+impl<'a> Context<'a> {
+    pub(super) fn new(
+        mesh: &Mesh,
+        strips: &Strips,
+        collapses: &'a Collapses,
+        options: &'a BuildOptions,
+    ) -> Context<'a> {
+        let mut positions = mesh.positions.clone();
+        positions.extend_from_slice(collapses.appended());
+        Context {
+            // Bands are stripified from the strips' own triangles, so that a
+            // model built again from its file (which stores the strips) is the
+            // same.
+            base: Mesh {
+                positions: mesh.positions.clone(),
+                triangles: strips.triangles(),
+                properties: Default::default(),
+            },
+            positions,
+            collapses,
+            options,
+            slack: options.band_slack,
+            max_lod: collapses.max_lod() as u32,
+        }
+    }
+
     /// The first LoDs of the segments the sequence is cut into: each ends
     /// where the triangle count has fallen by [`SEGMENT_DROP`].
     ///
@@ -310,7 +324,7 @@ impl Context<'_> {
     /// not depend on the thread count, so the model does not either.
     /// With an infinite slack (the paper's single band) there is one
     /// segment.
-    fn segment_starts(&self) -> Vec<u32> {
+    pub(super) fn segment_starts(&self) -> Vec<u32> {
         let counts = self.collapses.triangle_counts();
         let mut starts = Vec::new();
         let mut a = 0;
@@ -458,7 +472,7 @@ struct ArcRecord {
     res: u32,
 }
 
-struct Builder {
+pub(crate) struct Builder {
     /// Position → strip, and each strip's first position (`strip_base[s]`,
     /// one more entry than strips).
     pos_strip: Vec<u32>,
@@ -510,22 +524,21 @@ struct Builder {
     emitted: usize,
     breaks: usize,
     non_empty: usize,
+    /// Per strip, its share of `emitted + breaks`, and its live windows.
+    strip_indices: Vec<u32>,
+    strip_live: Vec<u32>,
 }
 
 impl Builder {
     /// A builder for strips that start at LoD `first` (their vertices are
     /// already those of that LoD).
-    fn new(strips: &Strips, vertex_count: usize, first: u32) -> Builder {
+    pub(crate) fn new(strips: &Strips, vertex_count: usize, first: u32) -> Builder {
         let total: usize = strips.runs().map(<[u32]>::len).sum();
-        assert!(
-            total < NODE_MASK as usize,
-            "strips too long for 31-bit node indices"
-        );
         let mut b = Builder {
             pos_strip: Vec::with_capacity(total),
             strip_base: Vec::with_capacity(strips.run_count() + 1),
             cur: Vec::with_capacity(total),
-            included: vec![true; total],
+            included: Vec::with_capacity(total),
             succ: Vec::with_capacity(total),
             prev_link: Vec::with_capacity(total),
             next_link: Vec::with_capacity(total),
@@ -533,7 +546,7 @@ impl Builder {
             node_of: Vec::with_capacity(total),
             occ_head: vec![NONE; vertex_count],
             occ_tail: vec![NONE; vertex_count],
-            occ_next: vec![NONE; total],
+            occ_next: Vec::with_capacity(total),
             node_pos: Vec::with_capacity(total),
             node_vertex: Vec::with_capacity(total),
             node_open: Vec::with_capacity(total),
@@ -542,7 +555,7 @@ impl Builder {
             begin_open: Vec::with_capacity(strips.run_count()),
             begins_closed: Vec::new(),
             touched: Vec::new(),
-            mark: vec![0; total],
+            mark: Vec::with_capacity(total),
             stamp: 0,
             old_span: Vec::new(),
             new_span: Vec::new(),
@@ -551,58 +564,81 @@ impl Builder {
             emitted: 0,
             breaks: 0,
             non_empty: 0,
+            strip_indices: Vec::with_capacity(strips.run_count()),
+            strip_live: Vec::with_capacity(strips.run_count()),
         };
-        for (s, run) in strips.runs().enumerate() {
-            let base = b.cur.len() as u32;
-            b.strip_base.push(base);
-            let len = run.len() as u32;
-            for (p, &v) in run.iter().enumerate() {
-                let gp = base + p as u32;
-                b.pos_strip.push(s as u32);
-                b.cur.push(v);
-                let is_window = (p as u32) + 2 < len;
-                let live = is_window && !crate::mesh::is_degenerate([v, run[p + 1], run[p + 2]]);
-                b.live.push(live);
-                b.push_occurrence(v, gp);
-            }
-            for p in 0..len {
-                let gp = base + p;
-                let live = b.live[gp as usize];
-                b.prev_link.push(if live {
-                    gp
-                } else if p == 0 {
-                    NONE
-                } else {
-                    gp - 1
-                });
-                b.next_link.push(if live {
-                    gp
-                } else if p + 3 >= len {
-                    NONE
-                } else {
-                    gp + 1
-                });
-            }
-            // LoD 0: the rule applied to the whole run.
-            b.included[base as usize..(base + len) as usize].fill(false);
-            b.node_of.extend(std::iter::repeat_n(NONE, len as usize));
-            b.succ.extend(std::iter::repeat_n(END, len as usize));
-            let live = b.encode_span(s, None, None);
-            let first_node = b.commit_new_span(None, None, first);
-            debug_assert_eq!(live.is_some(), first_node != END);
-            b.begin_open.push(first_node);
-            b.begin_since.push(first);
-            b.non_empty += usize::from(first_node != END);
+        b.strip_base.push(0);
+        for run in strips.runs() {
+            b.push_strip(run, first);
         }
-        b.strip_base.push(b.cur.len() as u32);
         b.replaying = true;
         b
+    }
+
+    /// Appends the strip `run` (vertices of LoD `lod`), born at `lod`: its
+    /// positions, windows and encoding at that LoD. Returns its index.
+    pub(crate) fn push_strip(&mut self, run: &[u32], lod: u32) -> usize {
+        let s = self.strip_base.len() - 1;
+        let base = self.cur.len() as u32;
+        let len = run.len() as u32;
+        assert!(
+            (base + len) < NODE_MASK,
+            "strips too long for 31-bit node indices"
+        );
+        self.strip_base.push(base + len);
+        let mut live_windows = 0;
+        for (p, &v) in run.iter().enumerate() {
+            let gp = base + p as u32;
+            self.pos_strip.push(s as u32);
+            self.cur.push(v);
+            let is_window = (p as u32) + 2 < len;
+            let live = is_window && !crate::mesh::is_degenerate([v, run[p + 1], run[p + 2]]);
+            live_windows += u32::from(live);
+            self.live.push(live);
+            self.occ_next.push(NONE);
+            self.push_occurrence(v, gp);
+        }
+        for p in 0..len {
+            let gp = base + p;
+            let live = self.live[gp as usize];
+            self.prev_link.push(if live {
+                gp
+            } else if p == 0 {
+                NONE
+            } else {
+                gp - 1
+            });
+            self.next_link.push(if live {
+                gp
+            } else if p + 3 >= len {
+                NONE
+            } else {
+                gp + 1
+            });
+        }
+        // At its birth: the rule applied to the whole run.
+        self.included
+            .extend(std::iter::repeat_n(false, len as usize));
+        self.mark.extend(std::iter::repeat_n(0, len as usize));
+        self.node_of.extend(std::iter::repeat_n(NONE, len as usize));
+        self.succ.extend(std::iter::repeat_n(END, len as usize));
+        self.strip_indices.push(0);
+        self.strip_live.push(live_windows);
+        let replaying = std::mem::replace(&mut self.replaying, false);
+        let live = self.encode_span(s, None, None);
+        let first_node = self.commit_new_span(None, None, lod);
+        self.replaying = replaying;
+        debug_assert_eq!(live.is_some(), first_node != END);
+        self.begin_open.push(first_node);
+        self.begin_since.push(lod);
+        self.non_empty += usize::from(first_node != END);
+        s
     }
 
     /// Indices of the band at the current LoD, as the extractor's compact
     /// buffer counts them: positions, run breaks, one restart between
     /// non-empty strips.
-    fn indices(&self) -> usize {
+    pub(crate) fn indices(&self) -> usize {
         self.emitted + self.breaks + self.non_empty.saturating_sub(1)
     }
 
@@ -739,7 +775,9 @@ impl Builder {
                 !self.replaying || self.included[p as usize],
                 "position {p} came back"
             );
-            self.emitted += usize::from(!self.included[p as usize]);
+            let fresh = !self.included[p as usize];
+            self.emitted += usize::from(fresh);
+            self.strip_indices[self.pos_strip[p as usize] as usize] += u32::from(fresh);
             self.included[p as usize] = true;
             self.mark[p as usize] = self.stamp;
         }
@@ -768,14 +806,17 @@ impl Builder {
     /// Sets the successor of emitted position `f`, counting run breaks.
     fn set_succ(&mut self, f: u32, succ: u32) {
         let old = self.succ[f as usize];
-        self.breaks -= usize::from(old != END && old & RESTART != 0);
-        self.breaks += usize::from(succ != END && succ & RESTART != 0);
+        let was = old != END && old & RESTART != 0;
+        let is = succ != END && succ & RESTART != 0;
+        self.breaks = self.breaks + usize::from(is) - usize::from(was);
+        let s = self.pos_strip[f as usize] as usize;
+        self.strip_indices[s] = self.strip_indices[s] + u32::from(is) - u32::from(was);
         self.succ[f as usize] = succ;
     }
 
     /// Replays one contraction: the positions of `moved` vertices now hold
     /// `target`, at LoD `lod`.
-    fn contract(&mut self, lod: u32, moves: &[(u32, u32)]) {
+    pub(crate) fn contract(&mut self, lod: u32, moves: &[(u32, u32)]) {
         self.touched.clear();
         for &(v, target) in moves {
             let mut gp = self.occ_head[v as usize];
@@ -816,6 +857,7 @@ impl Builder {
                 );
                 if x == y || y == z || x == z {
                     self.live[w as usize] = false;
+                    self.strip_live[s] -= 1;
                     self.prev_link[w as usize] = if w == base { NONE } else { w - 1 };
                     self.next_link[w as usize] = if w + 3 >= end { NONE } else { w + 1 };
                 }
@@ -890,8 +932,10 @@ impl Builder {
             if self.mark[q as usize] != self.stamp {
                 self.included[q as usize] = false;
                 let succ = self.succ[q as usize];
+                let broke = succ != END && succ & RESTART != 0;
                 self.emitted -= 1;
-                self.breaks -= usize::from(succ != END && succ & RESTART != 0);
+                self.breaks -= usize::from(broke);
+                self.strip_indices[s] -= 1 + u32::from(broke);
                 let n = self.node_of[q as usize];
                 if n != NONE {
                     self.close(n, lod - 1);
@@ -911,6 +955,142 @@ impl Builder {
                     self.non_empty + usize::from(first != END) - usize::from(old != END);
             }
         }
+    }
+
+    /// The strips the last [`Builder::contract`] changed, appended to `out`
+    /// (with repeats).
+    pub(crate) fn touched_strips(&self, out: &mut Vec<u32>) {
+        out.extend(self.touched.iter().map(|&gp| self.pos_strip[gp as usize]));
+    }
+
+    /// Strips so far, retired ones included.
+    pub(crate) fn strip_count(&self) -> usize {
+        self.strip_base.len() - 1
+    }
+
+    /// Strip `s`'s share of [`Builder::indices`] (its emitted positions and
+    /// run breaks) and its live windows (its triangles) now.
+    pub(crate) fn strip_state(&self, s: usize) -> (u32, u32) {
+        (self.strip_indices[s], self.strip_live[s])
+    }
+
+    /// Whether strip `s` draws anything now.
+    pub(crate) fn strip_drawn(&self, s: usize) -> bool {
+        self.begin_open[s] != END
+    }
+
+    /// The strips holding a position of vertex `v` now, appended to `out`
+    /// (a strip once per position).
+    pub(crate) fn strips_at_vertex(&self, v: u32, out: &mut Vec<u32>) {
+        let mut gp = self.occ_head[v as usize];
+        while gp != NONE {
+            if self.included[gp as usize] {
+                out.push(self.pos_strip[gp as usize]);
+            }
+            gp = self.occ_next[gp as usize];
+        }
+    }
+
+    /// Strip `s`'s triangles now (its live windows, oriented as drawn),
+    /// appended to `out`.
+    pub(crate) fn strip_triangles(&self, s: usize, out: &mut Vec<[u32; 3]>) {
+        let (base, end) = self.strip_range(s);
+        for w in base..end.saturating_sub(2) {
+            if self.live[w as usize] {
+                let [a, b, c] = [w, w + 1, w + 2].map(|p| self.cur[p as usize]);
+                out.push(if (w - base) % 2 == 0 {
+                    [a, b, c]
+                } else {
+                    [b, a, c]
+                });
+            }
+        }
+    }
+
+    /// Retires strip `s` at LoD `lod`: its last LoD is `lod - 1` (what a
+    /// contraction at `lod` opened leaves no record), its positions are
+    /// left out for good and it stops counting in [`Builder::indices`].
+    pub(crate) fn retire(&mut self, s: usize, lod: u32) {
+        let first = self.begin_open[s];
+        let mut p = if first == END {
+            END
+        } else {
+            self.node_pos[first as usize]
+        };
+        while p != END {
+            let q = p & NODE_MASK;
+            let succ = self.succ[q as usize];
+            self.included[q as usize] = false;
+            self.emitted -= 1;
+            self.breaks -= usize::from(succ != END && succ & RESTART != 0);
+            let n = self.node_of[q as usize];
+            if n != NONE {
+                self.close(n, lod - 1);
+                self.node_of[q as usize] = NONE;
+            }
+            p = succ;
+        }
+        // Nodes of positions left out earlier are closed already.
+        if self.begin_since[s] < lod {
+            self.begins_closed.push((s as u32, first, lod - 1));
+        }
+        self.non_empty -= usize::from(first != END);
+        self.begin_open[s] = END;
+        self.begin_since[s] = lod;
+        self.strip_indices[s] = 0;
+        let (base, end) = self.strip_range(s);
+        self.live[base as usize..end as usize].fill(false);
+        self.strip_live[s] = 0;
+    }
+
+    /// Node and arc records so far, counted as the model stores them: one
+    /// per arc, one for a node without arcs, with open arcs closed now;
+    /// and the largest label relative to its strip's birth.
+    pub(crate) fn record_count(&self, births: &[u32], last: u32) -> (usize, u32) {
+        let mut arcs = vec![0u32; self.node_pos.len()];
+        let mut span = 0;
+        let birth_of = |n: u32| births[self.pos_strip[self.node_pos[n as usize] as usize] as usize];
+        for r in &self.closed {
+            arcs[r.node as usize] += 1;
+            span = span.max(r.res - birth_of(r.node));
+        }
+        for (n, &open) in self.node_open.iter().enumerate() {
+            if open != NO_ARC && self.node_since[n] <= last {
+                arcs[n] += 1;
+                span = span.max(last - birth_of(n as u32));
+            }
+        }
+        (arcs.iter().map(|&a| a.max(1) as usize).sum(), span)
+    }
+
+    /// [`Builder::indices`] and each strip's share recounted by walking
+    /// every strip's emitted positions, for the tests.
+    #[cfg(test)]
+    pub(crate) fn recount(&self) -> (usize, Vec<u32>) {
+        let mut per_strip = vec![0u32; self.strip_count()];
+        let mut non_empty = 0;
+        for (s, count) in per_strip.iter_mut().enumerate() {
+            let first = self.begin_open[s];
+            non_empty += usize::from(first != END);
+            let mut p = if first == END {
+                END
+            } else {
+                self.node_pos[first as usize]
+            };
+            while p != END {
+                let q = p & NODE_MASK;
+                let succ = self.succ[q as usize];
+                *count += 1 + u32::from(succ != END && succ & RESTART != 0);
+                p = succ;
+            }
+        }
+        let total = per_strip.iter().map(|&c| c as usize).sum::<usize>();
+        (total + non_empty.saturating_sub(1), per_strip)
+    }
+
+    /// Beginnings so far (closed ones and one open per strip).
+    pub(crate) fn begin_count(&self) -> usize {
+        self.begins_closed.len() + self.begin_open.len()
     }
 
     /// Closes the band (its strips hold LoDs `first..=last`) and appends its

@@ -32,6 +32,7 @@ pub mod compress;
 mod digest;
 mod extract;
 pub mod format;
+pub mod lifetimes;
 mod pipeline;
 pub mod prefix;
 pub(crate) mod records;
@@ -147,6 +148,8 @@ pub struct ModelStats {
     pub nodes: usize,
     /// Graph arcs.
     pub arcs: usize,
+    /// Records (one per arc, one per node without arcs; `records.rs`).
+    pub records: usize,
     /// Entries of the strip-beginning lists.
     pub begins: usize,
     /// Bytes of the in-memory arrays.
@@ -288,6 +291,7 @@ impl MtsModel {
             strips: self.strip_count(),
             nodes: records - later,
             arcs: records - no_arc,
+            records,
             begins: self.begin_node.len(),
             memory_bytes: 4 * words
                 + self.rec_vertex.bytes()
