@@ -163,6 +163,42 @@ pub fn check(r: &Results, quick: bool) -> Vec<String> {
         need(!r.models.is_empty(), "no model measured".into());
         need(r.scale.is_some(), "no scale section".into());
     }
+    // Renewal rows: the five of `bench/renewal.rs` in order, the default
+    // bands (the reference) at ratio 1 with the model's band count, and
+    // the single band holding the fewest records.
+    for m in &r.models {
+        let at = format!("renewal {}", m.name);
+        let names: Vec<&str> = m.renewal.iter().map(|x| x.renewal.as_str()).collect();
+        need(
+            names == ["single band", "bands", "bands", "strips", "strips"],
+            format!("{at}: rows {names:?}"),
+        );
+        if names.len() != 5 {
+            continue;
+        }
+        let bands = &m.renewal[1];
+        need(
+            bands.mean_ratio == 1.0 && bands.worst_ratio == 1.0 && bands.renewals + 1 == m.bands,
+            format!(
+                "{at}: the default bands at ratio {} with {} renewals for {} bands",
+                bands.mean_ratio, bands.renewals, m.bands
+            ),
+        );
+        need(
+            m.renewal.iter().all(|x| x.records >= m.renewal[0].records),
+            format!("{at}: a row holds fewer records than the single band"),
+        );
+        for x in &m.renewal {
+            need(
+                x.indices_per_triangle.len() == SHARES.len()
+                    && x.indices_per_triangle.iter().all(|&i| i >= 1.0)
+                    && x.memory_bytes > 0
+                    && x.mean_ratio > 0.0
+                    && x.worst_ratio >= x.mean_ratio,
+                format!("{at} {}: an empty or impossible row", x.renewal),
+            );
+        }
+    }
     if let Some(FastSimplificationRun::Rows(rows)) = &r.fast_simplification {
         for f in rows {
             need(

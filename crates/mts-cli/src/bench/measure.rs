@@ -671,6 +671,7 @@ fn measure_model(
                 None
             }
         },
+        renewal: super::renewal::measure(&model, mesh),
     };
     Ok((row, model))
 }

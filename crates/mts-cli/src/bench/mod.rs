@@ -23,6 +23,7 @@ pub mod measure;
 pub mod methods;
 pub mod render;
 pub mod render_hierarchy;
+pub mod renewal;
 pub mod report;
 pub mod results;
 pub mod scene;

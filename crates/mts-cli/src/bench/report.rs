@@ -448,6 +448,11 @@ pub fn report(results: &Results) -> String {
             t.total,
         );
     }
+    let _ = writeln!(
+        s,
+        "\n### Table 1, renewal: the single band, bands and strips with lifetimes\n"
+    );
+    super::renewal::table(&mut s, models);
     let _ = writeln!(s, "\n## Strips against meshoptimizer\n");
     strips_table(&mut s, models);
     cache_aware_table(&mut s, models);

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Version of `results.json`'s layout (`docs/bench-schema.md`).
-pub const SCHEMA_VERSION: u32 = 10;
+pub const SCHEMA_VERSION: u32 = 11;
 
 /// Steps (of 255) an RGB byte may move before an image comparison
 /// (Figure 6's, the scene's, the properties') counts the pixel as changed.
@@ -159,6 +159,36 @@ pub struct Model {
     pub methods: Vec<MethodRow>,
     /// `null` without an adapter.
     pub figure6: Option<Figure6>,
+    /// The model's renewals side by side: the single band, bands and
+    /// per-strip lifetimes (`mts::model::lifetimes`).
+    pub renewal: Vec<RenewalRow>,
+}
+
+/// One renewal of the strips as the LoD coarsens, replayed over the
+/// model's sequence (`mts::model::lifetimes::measure_renewal`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenewalRow {
+    /// "single band", "bands" or "strips".
+    pub renewal: String,
+    /// The slack (`null` for the single band).
+    pub slack: Option<f64>,
+    /// A strips row's neighbourhood: fewest and most triangles.
+    pub unit_triangles: Option<[u64; 2]>,
+    pub strips_born: u64,
+    pub renewals: u64,
+    pub records: u64,
+    /// Bytes in the per-strip layout, every row alike.
+    pub memory_bytes: u64,
+    /// Indices sent per triangle at the report's shares
+    /// (`mts::methods::SHARES`).
+    pub indices_per_triangle: Vec<f64>,
+    /// Over the 100 shares 100%..1%: the mean and worst ratio of the
+    /// indices sent to the default bands', and the shares more than 2%
+    /// above.
+    pub mean_ratio: f64,
+    pub worst_ratio: f64,
+    pub shares_above: u64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

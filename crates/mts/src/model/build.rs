@@ -906,14 +906,7 @@ impl Builder {
         self.old_span.clear();
         let mut p = match a_prev {
             Some(a) => self.succ[(a + 2) as usize],
-            None => {
-                let first = self.begin_open[s];
-                if first == END {
-                    END
-                } else {
-                    self.node_pos[first as usize]
-                }
-            }
+            None => self.first_position(s),
         };
         while p != END {
             let q = p & NODE_MASK;
@@ -961,6 +954,16 @@ impl Builder {
     /// (with repeats).
     pub(crate) fn touched_strips(&self, out: &mut Vec<u32>) {
         out.extend(self.touched.iter().map(|&gp| self.pos_strip[gp as usize]));
+    }
+
+    /// The first emitted position of strip `s` now, or [`END`].
+    fn first_position(&self, s: usize) -> u32 {
+        let first = self.begin_open[s];
+        if first == END {
+            END
+        } else {
+            self.node_pos[first as usize]
+        }
     }
 
     /// Strips so far, retired ones included.
@@ -1012,11 +1015,7 @@ impl Builder {
     /// left out for good and it stops counting in [`Builder::indices`].
     pub(crate) fn retire(&mut self, s: usize, lod: u32) {
         let first = self.begin_open[s];
-        let mut p = if first == END {
-            END
-        } else {
-            self.node_pos[first as usize]
-        };
+        let mut p = self.first_position(s);
         while p != END {
             let q = p & NODE_MASK;
             let succ = self.succ[q as usize];
@@ -1070,13 +1069,8 @@ impl Builder {
         let mut per_strip = vec![0u32; self.strip_count()];
         let mut non_empty = 0;
         for (s, count) in per_strip.iter_mut().enumerate() {
-            let first = self.begin_open[s];
-            non_empty += usize::from(first != END);
-            let mut p = if first == END {
-                END
-            } else {
-                self.node_pos[first as usize]
-            };
+            non_empty += usize::from(self.begin_open[s] != END);
+            let mut p = self.first_position(s);
             while p != END {
                 let q = p & NODE_MASK;
                 let succ = self.succ[q as usize];
