@@ -1,6 +1,7 @@
 //! The `mts` command's model subcommands end to end: `build --json` keys,
 //! `extract` at a LoD, triangle budget and ratio, `verify` passing on a
-//! sound model and failing (non-zero exit, named place) on a corrupt file.
+//! sound model and failing (non-zero exit, named place) on a corrupt file;
+//! `simplify --regions`.
 
 mod common;
 
@@ -502,4 +503,61 @@ fn compress_writes_meshopt_gltf_that_reads_back() {
     );
     assert!(!std::path::Path::new(&obj).exists());
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `simplify --regions` makes the sequence in parts at once: the level is
+/// within the target, the JSON names the parts, and a mesh with vertex
+/// properties is refused with the reason.
+#[test]
+fn simplify_in_regions_reaches_the_target_and_refuses_properties() {
+    let (ok, out, err) = mts(&[
+        "simplify",
+        "--generated",
+        "torus:5k",
+        "--ratio",
+        "0.1",
+        "--regions",
+        "4",
+        "--samples",
+        "2000",
+        "--no-meshopt",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v = json(&out);
+    assert_eq!(v["regions"], 4);
+    let (triangles, target) = (
+        v["triangles"].as_u64().unwrap(),
+        v["target"].as_u64().unwrap(),
+    );
+    assert!(
+        triangles <= target && triangles + 10 >= target,
+        "{triangles} for {target}"
+    );
+    assert!(v["hausdorff"].as_f64().unwrap() < 0.05, "{out}");
+    let (ok, _, err) = mts(&[
+        "simplify",
+        "--generated",
+        "torus:2k",
+        "--properties",
+        "--ratio",
+        "0.1",
+        "--regions",
+        "2",
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("--regions") && err.contains("positions only"),
+        "{err}"
+    );
+    let (ok, _, err) = mts(&[
+        "simplify",
+        "--generated",
+        "torus:2k",
+        "--ratio",
+        "0.1",
+        "--regions",
+        "1",
+    ]);
+    assert!(!ok && err.contains("regions"), "{err}");
 }

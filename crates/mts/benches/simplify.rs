@@ -1,5 +1,5 @@
-//! Criterion: the whole contraction sequence (mts) beside meshoptimizer's
-//! `simplify` to 10% of the triangles, on the bunny (when
+//! Criterion: the whole contraction sequence (mts, serial and in 4 regions
+//! at once) beside meshoptimizer's `simplify` to 10% of the triangles, on the bunny (when
 //! `../shared/models` is present), on generated icospheres and on a dense
 //! non-manifold mesh (20,000 random distinct triangles over 256 vertices:
 //! issue 31's wide fans, `docs/experiments/simplify-dense.md`).
@@ -72,6 +72,23 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| simplify(black_box(m), &SimplifyOptions::default()));
             },
         );
+        // The same sequence made in 4 parts at once (`simplify_in_regions`),
+        // on meshes of positions only.
+        if mts::simplify::regions_refusal(&mesh, &SimplifyOptions::default()).is_none() {
+            group.bench_with_input(
+                BenchmarkId::new("mts_whole_sequence_4_regions", &name),
+                &mesh,
+                |b, m| {
+                    b.iter(|| {
+                        mts::simplify::simplify_in_regions(
+                            black_box(m),
+                            &SimplifyOptions::default(),
+                            4,
+                        )
+                    });
+                },
+            );
+        }
         let target = mesh.triangle_count() / 10;
         group.bench_with_input(
             BenchmarkId::new("meshopt_to_10_percent", &name),

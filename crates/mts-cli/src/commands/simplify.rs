@@ -56,6 +56,15 @@ pub struct SimplifyArgs {
     /// Skip meshoptimizer.
     #[arg(long)]
     pub no_meshopt: bool,
+    /// Contract the mesh in N parts at once on every core (a power of two,
+    /// 2 to 64; others round down), each to a quarter of its triangles
+    /// with its border locked, then the rest serially: a different
+    /// sequence, about half the time on two cores and a quarter or less on
+    /// large meshes (docs/experiments/simplify-speed.md). A mesh of
+    /// positions only (--positions-only), endpoint placement, no pair
+    /// distance.
+    #[arg(long, value_name = "N", value_parser = count_in::<2, 64>, allow_negative_numbers = true)]
+    pub regions: Option<usize>,
 }
 
 pub fn run(args: &SimplifyArgs) -> Result<()> {
@@ -94,17 +103,29 @@ pub fn run(args: &SimplifyArgs) -> Result<()> {
                 .unwrap_or(defaults.attribute_weights.color),
         },
     };
+    if args.regions.is_some() {
+        if let Some(why) = mts::simplify::regions_refusal(&mesh, &options) {
+            bail!("{name}: --regions: {why}");
+        }
+    }
+    let run = |options: &SimplifyOptions| match args.regions {
+        Some(n) => mts::simplify::simplify_in_regions(&mesh, options, n),
+        None => mts::simplify(&mesh, options),
+    };
     let t = Instant::now();
-    let whole = mts::simplify(&mesh, &options);
+    let whole = run(&options);
     let ms = t.elapsed().as_secs_f64() * 1e3;
     options.stop_at_triangles = Some(target);
     let t = Instant::now();
-    let partial = mts::simplify(&mesh, &options);
+    let partial = run(&options);
     let ms_to_target = t.elapsed().as_secs_f64() * 1e3;
     let collapses = &whole.collapses;
     let lod = collapses.lod_for_triangles(target);
-    // The early-stopped run must be a prefix of the whole sequence.
-    if partial.collapses.steps() != &collapses.steps()[..partial.collapses.max_lod()] {
+    // The early-stopped run must be a prefix of the whole sequence (in
+    // regions the parts stop at another share, so only the serial one).
+    if args.regions.is_none()
+        && partial.collapses.steps() != &collapses.steps()[..partial.collapses.max_lod()]
+    {
         bail!("internal error: the sequence stopped at the target differs from the whole one");
     }
     let skipped = peers::meshopt::refusal(&mesh);
@@ -159,6 +180,7 @@ pub fn run(args: &SimplifyArgs) -> Result<()> {
         "hausdorff": d.distance.hausdorff,
         "rms": d.distance.rms,
         "stop": whole.stop.to_string(),
+        "regions": args.regions,
         "meshopt": peer,
     });
     if args.json {
