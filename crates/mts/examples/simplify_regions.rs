@@ -3,7 +3,8 @@
 //!
 //! The scheme, as meshoptimizer's cluster LoD simplifies groups: the
 //! triangles are cut into `R` regions by median bisection of their
-//! centroids along the longest axis; each region (its vertices on a
+//! centroids along the longest axis (`simplify::cut_into_regions`; the
+//! library's `simplify_in_regions` is this example's one round to 25%); each region (its vertices on a
 //! border with another region locked, `simplify::simplify_locked`) is
 //! contracted on its own down to a share of its triangles (`stop=S`, 0 for
 //! as far as it goes; default 0.25); the regions' steps are
@@ -25,7 +26,7 @@
 use mts::distance::{surface_distance, Surface, DEFAULT_SAMPLES};
 use mts::mesh::generate::Generated;
 use mts::mesh::io::{load, LoadOptions};
-use mts::simplify::simplify_locked;
+use mts::simplify::{cut_into_regions, region_borders, simplify_locked};
 use mts::{Mesh, SimplifyOptions};
 use std::path::Path;
 use std::time::Instant;
@@ -52,42 +53,6 @@ fn diagonal(mesh: &Mesh) -> f64 {
         }
     }
     f64::from((hi - lo).length())
-}
-
-/// Triangle indices cut into `parts` regions (a power of two) by median
-/// bisection of their centroids along each part's longest axis.
-fn regions(mesh: &Mesh, parts: usize) -> Vec<Vec<u32>> {
-    let centroid = |t: u32| {
-        let [a, b, c] = mesh.triangles[t as usize].map(|v| mesh.positions[v as usize]);
-        (a + b + c) / 3.0
-    };
-    let mut out = vec![(0..mesh.triangles.len() as u32).collect::<Vec<u32>>()];
-    while out.len() < parts {
-        let mut next = Vec::new();
-        for mut part in out {
-            let (lo, hi) = part.iter().fold(
-                (glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY),
-                |(lo, hi), &t| (lo.min(centroid(t)), hi.max(centroid(t))),
-            );
-            let extent = hi - lo;
-            let axis = if extent.x >= extent.y && extent.x >= extent.z {
-                0
-            } else if extent.y >= extent.z {
-                1
-            } else {
-                2
-            };
-            let mid = part.len() / 2;
-            part.select_nth_unstable_by(mid, |&a, &b| {
-                centroid(a)[axis].total_cmp(&centroid(b)[axis])
-            });
-            let upper = part.split_off(mid);
-            next.push(part);
-            next.push(upper);
-        }
-        out = next;
-    }
-    out
 }
 
 /// The submesh of `triangles` with its own vertex numbering, the input
@@ -184,21 +149,8 @@ fn round(
         triangles,
         properties: Default::default(),
     };
-    let regions = regions(&current, parts);
-    let mut owner = vec![u32::MAX; mesh.positions.len()];
-    let mut locked = vec![false; mesh.positions.len()];
-    for (r, tris) in regions.iter().enumerate() {
-        for &t in tris {
-            for v in current.triangles[t as usize] {
-                let o = &mut owner[v as usize];
-                if *o == u32::MAX {
-                    *o = r as u32;
-                } else if *o != r as u32 {
-                    locked[v as usize] = true;
-                }
-            }
-        }
-    }
+    let regions = cut_into_regions(&current, parts);
+    let locked = region_borders(&current, &regions);
     let subs: Vec<_> = regions
         .iter()
         .map(|tris| submesh(&current, tris, &locked))

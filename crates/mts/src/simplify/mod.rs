@@ -23,7 +23,10 @@ mod regions;
 
 pub use collapses::{Collapse, Collapses};
 pub use contract::{simplify, simplify_locked};
-pub use regions::{regions_refusal, simplify_in_regions, MAX_REGIONS, REGION_SHARE};
+pub use regions::{
+    cut_into_regions, region_borders, regions_refusal, simplify_in_regions, MAX_REGIONS,
+    REGION_SHARE,
+};
 
 /// Where a contraction puts the surviving vertex.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

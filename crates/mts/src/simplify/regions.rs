@@ -84,8 +84,8 @@ pub fn simplify_in_regions(
     if regions < 2 || mesh.triangles.is_empty() {
         return simplify_locked(mesh, options, &[]);
     }
-    let parts = cut(mesh, 1 << regions.ilog2());
-    let locked = borders(mesh, &parts);
+    let parts = cut_into_regions(mesh, 1 << regions.ilog2());
+    let locked = region_borders(mesh, &parts);
     let total = mesh.triangle_count() as f64;
     let share = options
         .stop_at_triangles
@@ -148,9 +148,11 @@ pub fn simplify_in_regions(
     Simplification { collapses, stop }
 }
 
-/// Triangle indices cut into `parts` (a power of two) by median bisection
-/// of their centroids along each part's longest axis.
-fn cut(mesh: &Mesh, parts: usize) -> Vec<Vec<u32>> {
+/// `mesh`'s triangle indices cut into `parts` (rounded up to a power of
+/// two) by median bisection of their centroids along each part's longest
+/// axis (ties by index, so the cut is deterministic).
+#[must_use]
+pub fn cut_into_regions(mesh: &Mesh, parts: usize) -> Vec<Vec<u32>> {
     let centroid = |t: u32| {
         let [a, b, c] = mesh.triangles[t as usize].map(|v| mesh.positions[v as usize]);
         (a + b + c) / 3.0
@@ -182,8 +184,10 @@ fn cut(mesh: &Mesh, parts: usize) -> Vec<Vec<u32>> {
     out
 }
 
-/// One flag per vertex: used by triangles of two parts or more.
-fn borders(mesh: &Mesh, parts: &[Vec<u32>]) -> Vec<bool> {
+/// One flag per vertex of `mesh`: used by triangles of two or more of
+/// `parts` (triangle indices), the vertices [`simplify_in_regions`] locks.
+#[must_use]
+pub fn region_borders(mesh: &Mesh, parts: &[Vec<u32>]) -> Vec<bool> {
     let mut owner = vec![u32::MAX; mesh.positions.len()];
     let mut locked = vec![false; mesh.positions.len()];
     for (p, tris) in parts.iter().enumerate() {
