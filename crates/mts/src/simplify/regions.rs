@@ -364,6 +364,23 @@ mod tests {
         }
     }
 
+    /// More parts than triangles: empty parts contract nothing and the
+    /// sequence is still valid (the replay check runs in debug builds).
+    #[test]
+    fn more_regions_than_triangles_give_a_valid_sequence() {
+        for name in ["icosphere:20", "grid:8", "torus:50"] {
+            let m = mesh(name);
+            let s = simplify_in_regions(&m, &SimplifyOptions::default(), MAX_REGIONS);
+            assert_eq!(s.collapses.validate(), Ok(()), "{name}");
+            assert_eq!(
+                s.collapses.triangle_count(s.collapses.max_lod()),
+                s.stop.triangles,
+                "{name}"
+            );
+            assert!(s.stop.triangles < m.triangle_count(), "{name}");
+        }
+    }
+
     #[test]
     fn one_region_is_the_serial_sequence_and_properties_are_refused() {
         let m = mesh("torus:3k");
