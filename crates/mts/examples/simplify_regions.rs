@@ -43,43 +43,15 @@ struct Step {
     error: f64,
 }
 
-fn diagonal(mesh: &Mesh) -> f64 {
-    let mut lo = glam::Vec3::INFINITY;
-    let mut hi = glam::Vec3::NEG_INFINITY;
-    for t in &mesh.triangles {
-        for &v in t {
-            lo = lo.min(mesh.positions[v as usize]);
-            hi = hi.max(mesh.positions[v as usize]);
-        }
-    }
-    f64::from((hi - lo).length())
-}
-
-/// The submesh of `triangles` with its own vertex numbering, the input
-/// vertex of each local one, and the local lock flags.
+/// The submesh of `triangles` (indices into `mesh.triangles`) with its own
+/// vertex numbering (`Mesh::submesh`), the input vertex of each local one,
+/// and the local lock flags.
 fn submesh(mesh: &Mesh, triangles: &[u32], locked: &[bool]) -> (Mesh, Vec<u32>, Vec<bool>) {
-    let mut local = vec![u32::MAX; mesh.positions.len()];
-    let mut vertices = Vec::new();
-    let tris = triangles
+    let tris: Vec<[u32; 3]> = triangles
         .iter()
-        .map(|&t| {
-            mesh.triangles[t as usize].map(|v| {
-                if local[v as usize] == u32::MAX {
-                    local[v as usize] = vertices.len() as u32;
-                    vertices.push(v);
-                }
-                local[v as usize]
-            })
-        })
+        .map(|&t| mesh.triangles[t as usize])
         .collect();
-    let sub = Mesh {
-        positions: vertices
-            .iter()
-            .map(|&v| mesh.positions[v as usize])
-            .collect(),
-        triangles: tris,
-        properties: Default::default(),
-    };
+    let (sub, vertices) = mesh.submesh(&tris, &mut vec![u32::MAX; mesh.positions.len()]);
     let flags = vertices.iter().map(|&v| locked[v as usize]).collect();
     (sub, vertices, flags)
 }
@@ -97,7 +69,7 @@ fn contract_region(
         ..SimplifyOptions::default()
     };
     let s = simplify_locked(sub, &options, locked);
-    let d = diagonal(sub);
+    let d = sub.diagonal_f64();
     let steps = s
         .collapses
         .steps()
@@ -227,17 +199,13 @@ fn scheme(mesh: &Mesh, parts: usize, stop: f64, halving: bool, parallel: bool) -
     let region_steps = steps.len();
     // The mesh the regions leave, contracted serially to the end.
     let t = Instant::now();
-    let merged = Mesh {
-        positions: mesh.positions.clone(),
-        triangles: current,
-        properties: Default::default(),
-    };
+    let (merged, vertices) = mesh.submesh(&current, &mut vec![u32::MAX; mesh.positions.len()]);
     let offset = steps.last().map_or(0.0, |s| s.error);
-    let d = diagonal(&merged);
+    let d = merged.diagonal_f64();
     let tail = mts::simplify(&merged, &SimplifyOptions::default());
     steps.extend(tail.collapses.steps().iter().map(|c| Step {
-        removed: c.removed,
-        kept: c.kept,
+        removed: vertices[c.removed as usize],
+        kept: vertices[c.kept as usize],
         error: offset + f64::from(c.error) * d,
     }));
     Scheme {

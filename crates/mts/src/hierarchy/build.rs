@@ -6,7 +6,7 @@
 use super::grouping::group;
 use super::partition::partition;
 use super::{Cluster, Group, Hierarchy, HierarchyOptions, NO_GROUP, STUCK_RATIO};
-use crate::mesh::{Mesh, Properties};
+use crate::mesh::Mesh;
 use crate::model::MtsModel;
 use crate::simplify::{simplify_locked, Placement};
 use crate::strip::stripify;
@@ -253,23 +253,7 @@ fn build_group(
     options: &HierarchyOptions,
     remap: &mut [u32],
 ) -> Built {
-    let (vertices, local) = super::strips::renumber(triangles, remap);
-    let properties = if mesh.properties.is_empty() {
-        Properties::default()
-    } else {
-        Properties {
-            texture: None,
-            ..mesh.properties.gather(&vertices)
-        }
-    };
-    let submesh = Mesh {
-        positions: vertices
-            .iter()
-            .map(|&v| mesh.positions[v as usize])
-            .collect(),
-        triangles: local,
-        properties,
-    };
+    let (submesh, vertices) = mesh.submesh(triangles, remap);
     let loose = loose_border_points(&submesh);
     let locked: Vec<bool> = vertices
         .iter()
@@ -413,6 +397,7 @@ fn root(parent: &mut [usize], mut i: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::Properties;
 
     fn loose(triangles: Vec<[u32; 3]>) -> Vec<u32> {
         let n = triangles.iter().flatten().max().map_or(0, |&m| m + 1);

@@ -36,7 +36,7 @@ mod grouping;
 mod partition;
 mod runtime;
 mod select;
-pub(crate) mod strips;
+mod strips;
 
 pub use build::{build, build_with_progress, BuildProgress};
 pub use cracks::cracks;

@@ -9,7 +9,7 @@
 //! alike.
 
 use super::Hierarchy;
-use crate::mesh::Mesh;
+use crate::mesh::{renumber, Mesh};
 use crate::strip::encode::RESTART_U32 as RESTART;
 use crate::strip::{stripify, StripifyOptions};
 use glam::Vec3;
@@ -74,31 +74,6 @@ pub(super) fn strip_clusters(h: &mut Hierarchy, triangles: &[[u32; 3]], options:
         all.extend(indices);
     }
     h.cluster_strips = all;
-}
-
-/// `triangles` renumbered from 0 in order of first use: the vertices used
-/// (`vertices[i]` is local vertex `i`) and the local triangles. `remap` is
-/// all `u32::MAX` on entry and on return (one per input vertex). The
-/// submesh of a cluster here and of a group in `build.rs`.
-pub(crate) fn renumber(triangles: &[[u32; 3]], remap: &mut [u32]) -> (Vec<u32>, Vec<[u32; 3]>) {
-    let mut vertices: Vec<u32> = Vec::new();
-    let local: Vec<[u32; 3]> = triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                let r = &mut remap[v as usize];
-                if *r == u32::MAX {
-                    *r = vertices.len() as u32;
-                    vertices.push(v);
-                }
-                *r
-            })
-        })
-        .collect();
-    for &v in &vertices {
-        remap[v as usize] = u32::MAX;
-    }
-    (vertices, local)
 }
 
 /// The triangles that `strip` (runs separated by [`RESTART`]) draws.

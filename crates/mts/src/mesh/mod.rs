@@ -32,6 +32,32 @@ pub fn bounds_of(positions: &[Vec3]) -> Option<(Vec3, Vec3)> {
 
 pub use crate::encoding::is_degenerate;
 
+/// `triangles` renumbered from 0 in order of first use: the vertices used
+/// (`vertices[i]` is local vertex `i`) and the local triangles. `remap` is
+/// all `u32::MAX` on entry and on return (one per vertex `triangles`
+/// may index), so a caller cutting many parts allocates it once. O(len).
+#[must_use]
+pub fn renumber(triangles: &[[u32; 3]], remap: &mut [u32]) -> (Vec<u32>, Vec<[u32; 3]>) {
+    let mut vertices: Vec<u32> = Vec::new();
+    let local: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                let r = &mut remap[v as usize];
+                if *r == u32::MAX {
+                    *r = vertices.len() as u32;
+                    vertices.push(v);
+                }
+                *r
+            })
+        })
+        .collect();
+    for &v in &vertices {
+        remap[v as usize] = u32::MAX;
+    }
+    (vertices, local)
+}
+
 /// An indexed triangle mesh.
 ///
 /// Invariants (checked by [`Mesh::validate`]): every index is below
@@ -113,6 +139,33 @@ impl Mesh {
     #[must_use]
     pub fn raw_bytes_u16(&self) -> usize {
         12 * self.vertex_count() + 6 * self.triangle_count()
+    }
+
+    /// The part of the mesh drawn by `triangles` (over its vertices) as a
+    /// mesh of its own: the vertices they use, renumbered in order of first
+    /// use, with their properties (no texture: the whole mesh's serves),
+    /// and which vertex each local one is. A valid mesh: every vertex is
+    /// referenced. `remap` as [`renumber`]'s. O(len).
+    #[must_use]
+    pub fn submesh(&self, triangles: &[[u32; 3]], remap: &mut [u32]) -> (Mesh, Vec<u32>) {
+        let (vertices, local) = renumber(triangles, remap);
+        let properties = if self.properties.is_empty() {
+            Properties::default()
+        } else {
+            Properties {
+                texture: None,
+                ..self.properties.gather(&vertices)
+            }
+        };
+        let mesh = Mesh {
+            positions: vertices
+                .iter()
+                .map(|&v| self.positions[v as usize])
+                .collect(),
+            triangles: local,
+            properties,
+        };
+        (mesh, vertices)
     }
 
     /// Axis-aligned bounds `(min, max)`; `None` for a mesh without vertices.

@@ -368,7 +368,7 @@ impl Replay<'_> {
             self.builder.retire(t as usize, lod);
         }
         self.renewed_triangles += triangles.len();
-        let (vertices, local) = crate::hierarchy::strips::renumber(&triangles, &mut self.remap);
+        let (vertices, local) = crate::mesh::renumber(&triangles, &mut self.remap);
         let mesh = Mesh {
             positions: vertices
                 .iter()

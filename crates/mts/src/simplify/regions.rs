@@ -104,24 +104,14 @@ pub fn simplify_in_regions(
     // Stable: each part's steps stay in their order.
     steps.sort_by(|a, b| a.0.total_cmp(&b.0));
     let offset = steps.last().map_or(0.0, |s| s.0);
-    let left = Mesh {
-        positions: mesh.positions.clone(),
-        triangles: rest,
-        properties: Default::default(),
-    };
+    // What the parts leave, as a mesh of its own (every vertex used), so
+    // the simplifier's diagonal is the one its errors are scaled back by.
+    let (left, vertices) = mesh.submesh(&rest, &mut vec![u32::MAX; mesh.positions.len()]);
     let tail = simplify_locked(&left, options, &[]);
-    let scale = diagonal(&left);
-    let tail_counts = tail.collapses.triangle_counts();
-    steps.extend(tail.collapses.steps().iter().enumerate().map(|(i, c)| {
-        (
-            offset + f64::from(c.error) * scale,
-            Collapse { error: 0.0, ..*c },
-            tail_counts[i] - tail_counts[i + 1],
-        )
-    }));
+    steps.extend(part_steps(&left, &vertices, &tail.collapses, offset));
     // The parts hold disjoint triangles, so the count after a step is the
     // count before less what the step removed in its own part.
-    let input = diagonal(mesh).max(f64::MIN_POSITIVE);
+    let input = mesh.diagonal_f64().max(f64::MIN_POSITIVE);
     let mut running = 0.0f32;
     let mut counts = Vec::with_capacity(steps.len() + 1);
     counts.push(mesh.triangle_count() as u32);
@@ -221,40 +211,14 @@ fn contract_part(
         .iter()
         .map(|&t| mesh.triangles[t as usize])
         .collect();
-    let (vertices, local_tris) = crate::hierarchy::strips::renumber(&tris, local);
-    let part = Mesh {
-        positions: vertices
-            .iter()
-            .map(|&v| mesh.positions[v as usize])
-            .collect(),
-        triangles: local_tris,
-        properties: Default::default(),
-    };
+    let (part, vertices) = mesh.submesh(&tris, local);
     let flags: Vec<bool> = vertices.iter().map(|&v| locked[v as usize]).collect();
     let part_options = SimplifyOptions {
         stop_at_triangles: Some((share * part.triangle_count() as f64).ceil() as usize),
         ..*options
     };
     let s = simplify_locked(&part, &part_options, &flags);
-    let scale = diagonal(&part);
-    let counts = s.collapses.triangle_counts();
-    let steps = s
-        .collapses
-        .steps()
-        .iter()
-        .enumerate()
-        .map(|(i, c)| {
-            (
-                f64::from(c.error) * scale,
-                Collapse {
-                    removed: vertices[c.removed as usize],
-                    kept: vertices[c.kept as usize],
-                    error: 0.0,
-                },
-                counts[i] - counts[i + 1],
-            )
-        })
-        .collect();
+    let steps = part_steps(&part, &vertices, &s.collapses, 0.0);
     let left = s
         .collapses
         .triangles_at(&part, s.collapses.max_lod())
@@ -264,20 +228,29 @@ fn contract_part(
     (steps, left)
 }
 
-/// The bounding-box diagonal of the vertices `mesh`'s triangles use.
-fn diagonal(mesh: &Mesh) -> f64 {
-    let (lo, hi) = mesh.triangles.iter().flatten().fold(
-        (Vec3::INFINITY, Vec3::NEG_INFINITY),
-        |(lo, hi), &v| {
-            let p = mesh.positions[v as usize];
-            (lo.min(p), hi.max(p))
-        },
-    );
-    if lo.x > hi.x {
-        0.0
-    } else {
-        f64::from((hi - lo).length())
-    }
+/// The steps of `collapses` (a sequence of `part`, whose vertex `i` is
+/// `vertices[i]`) over the input's vertices, each with its error in model
+/// units plus `offset` (the simplifier's errors are relative to the
+/// part's own diagonal) and the triangles it removes.
+fn part_steps(part: &Mesh, vertices: &[u32], collapses: &Collapses, offset: f64) -> Vec<PartStep> {
+    let scale = part.diagonal_f64();
+    let counts = collapses.triangle_counts();
+    collapses
+        .steps()
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            (
+                offset + f64::from(c.error) * scale,
+                Collapse {
+                    removed: vertices[c.removed as usize],
+                    kept: vertices[c.kept as usize],
+                    error: 0.0,
+                },
+                counts[i] - counts[i + 1],
+            )
+        })
+        .collect()
 }
 
 #[cfg(test)]
